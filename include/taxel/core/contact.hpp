@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: MIT
+// A tactile contact measurement and helpers for its measurement covariance.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "taxel/core/types.hpp"
+
+namespace taxel {
+
+/// One 3-D contact point as measured by a tactile sensor, in the world frame.
+/// Trivially copyable; 88 bytes for double, 48 for float.
+template <Scalar S>
+struct Contact {
+  Vec3<S> position = Vec3<S>::Zero();  ///< contact location [m], world frame
+  /// Measurement covariance of `position` [m^2]; symmetric positive definite.
+  /// Default: isotropic, 1 mm standard deviation.
+  Mat3<S> covariance = Mat3<S>::Identity() * S(1e-6);
+  std::optional<Vec3<S>> normal;  ///< unit outward pad normal [-], world frame, if known
+  S pressure = S(0);              ///< contact pressure [Pa], or the sensor's raw units
+  double time = 0.0;              ///< acquisition time [s]
+};
+
+/// Standard deviation [m] of a uniform quantisation over one tactel of the given pitch [m]:
+/// pitch / sqrt(12).
+template <Scalar S>
+constexpr S tactel_sigma(S pitch) noexcept {
+  return pitch / S(3.4641016151377545870548926830117);
+}
+
+/// Isotropic covariance sigma^2 * I [m^2] for a standard deviation sigma [m].
+template <Scalar S>
+Mat3<S> isotropic_covariance(S sigma) {
+  if (!(sigma > S(0)) || !std::isfinite(sigma)) {
+    throw std::invalid_argument("isotropic_covariance: sigma must be finite and > 0");
+  }
+  return Mat3<S>::Identity() * (sigma * sigma);
+}
+
+/// Anisotropic pad covariance [m^2]: standard deviation `sigma_normal` along `normal` and
+/// `sigma_tangent` in the plane orthogonal to it, i.e.
+/// sigma_t^2 I + (sigma_n^2 - sigma_t^2) n n^T with n = normal / |normal|.
+/// Eigenvalues: sigma_n^2 (eigenvector n) and sigma_t^2 (twice, the pad plane).
+/// Throws std::invalid_argument for a zero or non-finite normal or non-positive sigmas.
+template <Scalar S>
+Mat3<S> pad_covariance(const Vec3<S>& normal, S sigma_normal, S sigma_tangent) {
+  const S len = normal.norm();
+  if (!std::isfinite(len) || !(len > S(0))) {
+    throw std::invalid_argument("pad_covariance: normal must be finite and non-zero");
+  }
+  if (!(sigma_normal > S(0)) || !(sigma_tangent > S(0)) || !std::isfinite(sigma_normal) ||
+      !std::isfinite(sigma_tangent)) {
+    throw std::invalid_argument(
+        "pad_covariance: sigma_normal and sigma_tangent must be finite and > 0");
+  }
+  const Vec3<S> n = normal / len;
+  const S sn2 = sigma_normal * sigma_normal;
+  const S st2 = sigma_tangent * sigma_tangent;
+  return Mat3<S>::Identity() * st2 + (sn2 - st2) * (n * n.transpose());
+}
+
+/// Why a contact cannot be used; `ok` when it can.
+enum class ContactDefect {
+  ok,
+  non_finite_position,     ///< position has NaN or Inf
+  non_finite_covariance,   ///< covariance has NaN or Inf
+  asymmetric_covariance,   ///< covariance differs from its transpose beyond rounding
+  indefinite_covariance,   ///< covariance is not positive definite
+  bad_normal,              ///< normal is present but not finite or not of unit length (1e-3)
+};
+
+/// Short description of a contact defect.
+constexpr std::string_view to_string(ContactDefect d) noexcept {
+  switch (d) {
+    case ContactDefect::ok: return "ok";
+    case ContactDefect::non_finite_position: return "position is not finite";
+    case ContactDefect::non_finite_covariance: return "covariance is not finite";
+    case ContactDefect::asymmetric_covariance: return "covariance is not symmetric";
+    case ContactDefect::indefinite_covariance: return "covariance is not positive definite";
+    case ContactDefect::bad_normal: return "normal is not a finite unit vector";
+  }
+  return "unknown";
+}
+
+/// True when `m` equals its transpose to within 64 ulps of its largest entry.
+template <Scalar S>
+bool is_symmetric(const Mat3<S>& m) noexcept {
+  const S tol = S(64) * std::numeric_limits<S>::epsilon() * m.cwiseAbs().maxCoeff();
+  return std::abs(m(0, 1) - m(1, 0)) <= tol && std::abs(m(0, 2) - m(2, 0)) <= tol &&
+         std::abs(m(1, 2) - m(2, 1)) <= tol;
+}
+
+/// True when `m` is symmetric (see `is_symmetric`) and positive definite by Sylvester's
+/// criterion (all leading principal minors > 0). O(1), no allocation.
+template <Scalar S>
+bool is_symmetric_positive_definite(const Mat3<S>& m) noexcept {
+  if (!is_symmetric(m)) return false;
+  const S minor2 = m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0);
+  return m(0, 0) > S(0) && minor2 > S(0) && m.determinant() > S(0);
+}
+
+/// Checks a contact for the defects that would corrupt a model fed with it. O(1).
+template <Scalar S>
+ContactDefect check_contact(const Contact<S>& c) noexcept {
+  if (!c.position.allFinite()) return ContactDefect::non_finite_position;
+  if (!c.covariance.allFinite()) return ContactDefect::non_finite_covariance;
+  if (!is_symmetric(c.covariance)) return ContactDefect::asymmetric_covariance;
+  if (!is_symmetric_positive_definite(c.covariance)) return ContactDefect::indefinite_covariance;
+  if (c.normal && (!c.normal->allFinite() || std::abs(c.normal->norm() - S(1)) > S(1e-3))) {
+    return ContactDefect::bad_normal;
+  }
+  return ContactDefect::ok;
+}
+
+}  // namespace taxel

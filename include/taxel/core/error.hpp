@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: MIT
+// Exceptions for bad file and device input, carrying where the input went wrong.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace taxel {
+
+/// A file or stream could not be read or written, or its content is malformed.
+/// `what()` reads "<source>:<line>: <reason>" or "<source>: byte <offset>: <reason>".
+class IoError : public std::runtime_error {
+ public:
+  /// `source` names the file (or stream); `line` is 1-based; `byte_offset` is 0-based.
+  IoError(std::string source, std::string reason, std::optional<std::uint64_t> line = {},
+          std::optional<std::uint64_t> byte_offset = {})
+      : std::runtime_error(format(source, reason, line, byte_offset)),
+        source_(std::move(source)),
+        reason_(std::move(reason)),
+        line_(line),
+        byte_offset_(byte_offset) {}
+
+  /// The file or stream name.
+  [[nodiscard]] const std::string& source() const noexcept { return source_; }
+  /// What was wrong, without the location.
+  [[nodiscard]] const std::string& reason() const noexcept { return reason_; }
+  /// 1-based line of the error in a text input, if known.
+  [[nodiscard]] std::optional<std::uint64_t> line() const noexcept { return line_; }
+  /// 0-based byte offset of the error, if known.
+  [[nodiscard]] std::optional<std::uint64_t> byte_offset() const noexcept { return byte_offset_; }
+
+ private:
+  static std::string format(const std::string& source, const std::string& reason,
+                            std::optional<std::uint64_t> line,
+                            std::optional<std::uint64_t> byte_offset) {
+    std::string s = source;
+    if (line) s += ":" + std::to_string(*line);
+    if (byte_offset) s += ": byte " + std::to_string(*byte_offset);
+    return s + ": " + reason;
+  }
+
+  std::string source_;
+  std::string reason_;
+  std::optional<std::uint64_t> line_;
+  std::optional<std::uint64_t> byte_offset_;
+};
+
+/// A device answered with bytes that violate its protocol (bad checksum, unexpected packet,
+/// impossible length, error code). `what()` reads "<device>: <reason>".
+class ProtocolError : public std::runtime_error {
+ public:
+  /// `device` names the device or transport; `packet_id` is the offending packet, if known.
+  ProtocolError(std::string device, std::string reason, std::optional<int> packet_id = {})
+      : std::runtime_error(device + ": " + reason), device_(std::move(device)),
+        packet_id_(packet_id) {}
+
+  /// The device or transport name.
+  [[nodiscard]] const std::string& device() const noexcept { return device_; }
+  /// The packet identifier the error concerns, if known.
+  [[nodiscard]] std::optional<int> packet_id() const noexcept { return packet_id_; }
+
+ private:
+  std::string device_;
+  std::optional<int> packet_id_;
+};
+
+}  // namespace taxel

@@ -1,0 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Umbrella header: all of taxel.
+#pragma once
+
+#include "taxel/core.hpp"

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Installs the Debian 12 packages taxel needs when they are missing.
+# Usage: scripts/install-deps.sh [build|test|bench|fuzz|all]   (default: test)
+set -euo pipefail
+
+what=${1:-test}
+pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev)
+case "$what" in
+  build) ;;
+  test) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev) ;;
+  bench) pkgs+=(libbenchmark-dev) ;;
+  fuzz) pkgs+=(catch2 clang libclang-rt-14-dev) ;;
+  all) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev clang libclang-rt-14-dev) ;;
+  *) echo "install-deps.sh: unknown set '$what' (build|test|bench|fuzz|all)" >&2; exit 2 ;;
+esac
+
+missing=()
+for p in "${pkgs[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+if [ "$(id -u)" -eq 0 ]; then
+  echo "install-deps.sh: installing ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+elif command -v sudo >/dev/null && sudo -n true 2>/dev/null; then
+  echo "install-deps.sh: installing ${missing[*]} with sudo" >&2
+  sudo -n env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  sudo -n env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null
+else
+  echo "install-deps.sh: missing Debian packages: ${missing[*]}" >&2
+  echo "install them with: sudo apt-get install ${missing[*]}" >&2
+  exit 1
+fi

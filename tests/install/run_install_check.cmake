@@ -1,0 +1,42 @@
+# SPDX-License-Identifier: MIT
+# ctest script: install taxel to a temporary prefix, then configure, build and run consumers
+# that find it through find_package, pkg-config and add_subdirectory.
+file(REMOVE_RECURSE "${WORK_DIR}")
+set(prefix "${WORK_DIR}/prefix")
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    string(REPLACE ";" " " cmd "${ARGN}")
+    message(FATAL_ERROR "command failed (${rc}): ${cmd}\n${out}\n${err}")
+  endif()
+  message(STATUS "${out}")
+endfunction()
+
+if(CONFIG)
+  set(config_arg --config ${CONFIG})
+endif()
+run(${CMAKE_COMMAND} --install "${TAXEL_BINARY_DIR}" --prefix "${prefix}" ${config_arg})
+foreach(f share/cmake/taxel/taxelConfig.cmake share/cmake/taxel/taxelConfigVersion.cmake
+          share/cmake/taxel/taxelTargets.cmake share/pkgconfig/taxel.pc include/taxel/taxel.hpp)
+  if(NOT EXISTS "${prefix}/${f}")
+    message(FATAL_ERROR "install did not produce ${f}")
+  endif()
+endforeach()
+
+set(consumers "${TAXEL_SOURCE_DIR}/tests/install")
+foreach(kind cmake pkgconfig subdir)
+  set(build "${WORK_DIR}/build_${kind}")
+  run(${CMAKE_COMMAND} -E env "PKG_CONFIG_PATH=${prefix}/share/pkgconfig"
+      ${CMAKE_COMMAND} -S "${consumers}/consumer_${kind}" -B "${build}"
+      "-DCMAKE_PREFIX_PATH=${prefix}" "-DTAXEL_SOURCE_DIR=${TAXEL_SOURCE_DIR}"
+      "-DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER}" -DCMAKE_BUILD_TYPE=Release)
+  run(${CMAKE_COMMAND} --build "${build}")
+  run("${build}/consumer")
+endforeach()
+
+# The package config must come from the prefix, not from the source or build tree.
+file(READ "${WORK_DIR}/build_cmake/CMakeCache.txt" cache)
+if(NOT cache MATCHES "taxel_DIR:PATH=${prefix}/share/cmake/taxel")
+  message(FATAL_ERROR "consumer found taxel somewhere other than ${prefix}")
+endif()
