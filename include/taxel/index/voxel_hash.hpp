@@ -1,0 +1,394 @@
+// SPDX-License-Identifier: MIT
+// VoxelHash: an exact incremental spatial index on a hashed voxel grid, tuned for the
+// "nearest point within the association radius" query of contact fusion.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "taxel/core/assert.hpp"
+#include "taxel/index/concepts.hpp"
+
+namespace taxel::index {
+
+/// Exact incremental spatial index over a hashed voxel grid.
+///
+/// Cells are cubes of side 2r for the radius r given at construction, so a ball of radius
+/// <= r meets at most a 2x2x2 block of cells; the cell holding the query is read first and
+/// the others only when they can still hold a closer point. Layout is flat: an open-addressing
+/// table (linear probing, 16-byte slots) maps a cell to a chain of fixed-size blocks in one
+/// pool; a block holds up to kBlockCapacity points (ids and coordinates side by side). There
+/// are no per-cell heap containers, and `move` within a cell rewrites the coordinates in place.
+/// Larger radii and k-NN queries work too (exactly), by visiting more cells.
+///
+/// Complexity: nearest_within(q, r_cfg) reads <= 8 cells; insert/move/erase are O(1) amortised
+/// (a move across cells touches two cells). Memory: see `memory_bytes()`; about 60-90 bytes per
+/// point for double at the densities of fused tactile clouds. No allocation in `move` within a
+/// cell or in `nearest_within`. Coordinates beyond 2^30 cells from the origin share the
+/// outermost cells (still exact, slower). Const queries may run concurrently; writes may not.
+template <Scalar S>
+class VoxelHash {
+ public:
+  using Scalar = S;
+  /// Tuning knobs; defaults suit fusion.
+  struct Config {
+    double max_load_factor = 0.5;  ///< of the cell table, in (0, 0.9]
+  };
+  /// Points per block: a block fits in two 64-byte cache lines.
+  static constexpr std::uint32_t kBlockCapacity = sizeof(S) == 8 ? 4 : 7;
+
+  /// `radius` [m]: the query radius served by a 2x2x2 block of cells (the association radius).
+  /// Throws std::invalid_argument when radius is not finite and > 0 or the load factor is out
+  /// of range.
+  explicit VoxelHash(S radius, const Config& config = {}) : config_(config) {
+    if (!(radius > S(0)) || !std::isfinite(radius)) {
+      throw std::invalid_argument("VoxelHash: radius must be finite and > 0, got " +
+                                  std::to_string(radius));
+    }
+    if (!(config.max_load_factor > 0.0 && config.max_load_factor <= 0.9)) {
+      throw std::invalid_argument("VoxelHash::Config::max_load_factor must be in (0, 0.9], got " +
+                                  std::to_string(config.max_load_factor));
+    }
+    cell_ = S(2) * probe_radius(radius) * (S(1) + S(16) * kEps);
+    inv_cell_ = S(1) / cell_;
+    slots_.assign(16, Slot{});
+  }
+
+  /// Side of a cell [m].
+  [[nodiscard]] S cell_size() const noexcept { return cell_; }
+
+  /// Adds point `p` (finite) with a new `id`.
+  void insert(PointId id, const Vec3<S>& p) {
+    TAXEL_ASSERT(!contains(id), "VoxelHash::insert: id already stored");
+    TAXEL_ASSERT(p.allFinite(), "VoxelHash::insert: point is not finite");
+    if (id >= loc_.size()) loc_.resize(std::size_t{id} + 1, Loc{});
+    place(id, p, key_of(p));
+    ++size_;
+  }
+
+  /// Moves stored point `id` to `p` (finite).
+  void move(PointId id, const Vec3<S>& p) {
+    TAXEL_ASSERT(contains(id), "VoxelHash::move: id not stored");
+    TAXEL_ASSERT(p.allFinite(), "VoxelHash::move: point is not finite");
+    const Loc at = loc_[id];
+    Block& b = blocks_[at.block];
+    const Key old_key = key_of(Vec3<S>(b.x[at.lane], b.y[at.lane], b.z[at.lane]));
+    const Key new_key = key_of(p);
+    if (old_key == new_key) {
+      b.x[at.lane] = p.x();
+      b.y[at.lane] = p.y();
+      b.z[at.lane] = p.z();
+      return;
+    }
+    unlink(id, old_key);
+    place(id, p, new_key);
+  }
+
+  /// Removes stored point `id`.
+  void erase(PointId id) {
+    TAXEL_ASSERT(contains(id), "VoxelHash::erase: id not stored");
+    const Loc at = loc_[id];
+    const Block& b = blocks_[at.block];
+    unlink(id, key_of(Vec3<S>(b.x[at.lane], b.y[at.lane], b.z[at.lane])));
+    --size_;
+  }
+
+  /// Removes every point; keeps the allocated capacity.
+  void clear() noexcept {
+    std::fill(slots_.begin(), slots_.end(), Slot{});
+    blocks_.clear();
+    free_blocks_.clear();
+    std::fill(loc_.begin(), loc_.end(), Loc{});
+    cells_ = 0;
+    size_ = 0;
+  }
+
+  /// Prepares for about `n` points without reallocation.
+  void reserve(std::size_t n) {
+    loc_.reserve(n);
+    blocks_.reserve(n / 2 + 1);
+    std::size_t want = slots_.size();
+    while (static_cast<double>(n / 2 + 1) > config_.max_load_factor * static_cast<double>(want)) {
+      want *= 2;
+    }
+    if (want != slots_.size()) rehash(want);
+  }
+
+  /// True when `id` is stored.
+  [[nodiscard]] bool contains(PointId id) const noexcept {
+    return id < loc_.size() && loc_[id].block != kNone;
+  }
+  /// Number of stored points.
+  [[nodiscard]] std::size_t size() const noexcept { return size_; }
+  /// Number of cells that ever held a point since the last clear.
+  [[nodiscard]] std::size_t cell_count() const noexcept { return cells_; }
+  /// Heap bytes held (table, block pool, per-id locations).
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    return slots_.capacity() * sizeof(Slot) + blocks_.capacity() * sizeof(Block) +
+           free_blocks_.capacity() * sizeof(std::uint32_t) + loc_.capacity() * sizeof(Loc);
+  }
+
+  /// The closest point within distance r of q (ties by id), if any. No allocation.
+  [[nodiscard]] std::optional<Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
+    if (size_ == 0 || !q.allFinite() || !(r >= S(0))) return std::nullopt;
+    const S rp = probe_radius(r);
+    const Key lo = key_of(Vec3<S>(q.array() - rp));
+    const Key hi = key_of(Vec3<S>(q.array() + rp));
+    const Key home = key_of(q);
+    Neighbor<S> best{0, r * r};
+    bool found = false;
+    auto visit = [&](const Block& b) {
+      for (std::uint32_t l = 0; l < b.count; ++l) {
+        const Neighbor<S> n{b.ids[l], squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q)};
+        if (n.squared_distance < best.squared_distance ||
+            (n.squared_distance == best.squared_distance && (!found || n.id < best.id))) {
+          best = n;
+          found = true;
+        }
+      }
+    };
+    if (volume(lo, hi) > static_cast<double>(cells_)) {
+      for (const Block& b : blocks_) visit(b);
+      return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
+    }
+    // The home cell first: in fusion it usually holds the answer, which prunes the others.
+    visit_cell(home, visit);
+    const S slack = cell_ * S(1e-4) + q.cwiseAbs().maxCoeff() * S(8) * kEps;
+    for (std::int32_t x = lo.x; x <= hi.x; ++x) {
+      const S dx = axis_gap(q.x(), x, slack);
+      for (std::int32_t y = lo.y; y <= hi.y; ++y) {
+        const S dy = axis_gap(q.y(), y, slack);
+        for (std::int32_t z = lo.z; z <= hi.z; ++z) {
+          const Key k{x, y, z};
+          if (k == home) continue;
+          const S dz = axis_gap(q.z(), z, slack);
+          if (dx * dx + dy * dy + dz * dz > best.squared_distance) continue;
+          visit_cell(k, visit);
+        }
+      }
+    }
+    return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
+  }
+
+  /// Every point within distance r of q, ordered by `closer`.
+  [[nodiscard]] std::vector<Neighbor<S>> within(const Vec3<S>& q, S r) const {
+    std::vector<Neighbor<S>> out;
+    if (size_ == 0 || !q.allFinite() || !(r >= S(0))) return out;
+    const S r2 = r * r;
+    auto visit = [&](const Block& b) {
+      for (std::uint32_t l = 0; l < b.count; ++l) {
+        const S d2 = squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q);
+        if (d2 <= r2) out.push_back({b.ids[l], d2});
+      }
+    };
+    const S rp = probe_radius(r);
+    const Key lo = key_of(Vec3<S>(q.array() - rp));
+    const Key hi = key_of(Vec3<S>(q.array() + rp));
+    if (volume(lo, hi) > static_cast<double>(cells_)) {
+      for (const Block& b : blocks_) visit(b);  // freed blocks are empty
+    } else {
+      for (std::int32_t x = lo.x; x <= hi.x; ++x) {
+        for (std::int32_t y = lo.y; y <= hi.y; ++y) {
+          for (std::int32_t z = lo.z; z <= hi.z; ++z) {
+            visit_cell(Key{x, y, z}, visit);
+          }
+        }
+      }
+    }
+    std::sort(out.begin(), out.end(), closer<S>);
+    return out;
+  }
+
+  /// The min(k, size()) closest points, ordered by `closer`: radius searches that double the
+  /// radius until k points are inside (a ball holding k points holds the k nearest).
+  [[nodiscard]] std::vector<Neighbor<S>> knn(const Vec3<S>& q, std::size_t k) const {
+    const std::size_t want = std::min(k, size_);
+    if (want == 0 || !q.allFinite()) return {};
+    for (S r = cell_ / 2;; r *= 2) {
+      std::vector<Neighbor<S>> found = within(q, r);
+      if (found.size() >= want || !std::isfinite(r)) {
+        found.resize(std::min(want, found.size()));
+        return found;
+      }
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  static constexpr S kEps = std::numeric_limits<S>::epsilon();
+  // Cell coordinates are clamped so they fit int32 and are exactly representable in float.
+  static constexpr S kMaxCell = S(1 << 30);
+
+  struct Key {
+    std::int32_t x = 0, y = 0, z = 0;
+    friend bool operator==(const Key&, const Key&) = default;
+  };
+  struct Slot {
+    Key key;
+    std::uint32_t head = kNone;  // kNone: never used (ends a probe run)
+  };
+  struct Block {
+    std::uint32_t count = 0;
+    std::uint32_t next = kNone;
+    PointId ids[kBlockCapacity];
+    S x[kBlockCapacity], y[kBlockCapacity], z[kBlockCapacity];
+  };
+  struct Loc {
+    std::uint32_t block = kNone;
+    std::uint32_t lane = 0;
+  };
+
+  // A point whose computed distance is <= r lies within r (1 + 3 eps) of q on every axis;
+  // probing cells over q +- r (1 + 16 eps) therefore finds it, because rounding is monotone
+  // and the stored coordinate is representable (cell_of(fl(q - rp)) <= cell_of(p)).
+  static S probe_radius(S r) noexcept { return r * (S(1) + S(16) * kEps); }
+
+  std::int32_t cell_of(S v) const noexcept {
+    const S c = std::clamp(std::floor(v * inv_cell_), -kMaxCell, kMaxCell);
+    return static_cast<std::int32_t>(c);
+  }
+  Key key_of(const Vec3<S>& p) const noexcept {
+    return {cell_of(p.x()), cell_of(p.y()), cell_of(p.z())};
+  }
+  static double volume(const Key& lo, const Key& hi) noexcept {
+    return (double(hi.x) - lo.x + 1) * (double(hi.y) - lo.y + 1) * (double(hi.z) - lo.z + 1);
+  }
+  // Lower bound on |v - (any coordinate stored in cell i)|, shrunk by `slack` for rounding.
+  S axis_gap(S v, std::int32_t i, S slack) const noexcept {
+    const S lo = static_cast<S>(i) * cell_;
+    const S hi = lo + cell_;
+    const S gap = v < lo ? lo - v : (v > hi ? v - hi : S(0));
+    return std::max(S(0), gap - slack);
+  }
+
+  static std::uint64_t hash(const Key& k) noexcept {
+    std::uint64_t h = std::uint64_t(std::uint32_t(k.x)) * 0x9E3779B97F4A7C15ULL;
+    h ^= std::uint64_t(std::uint32_t(k.y)) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= std::uint64_t(std::uint32_t(k.z)) * 0x165667B19E3779F9ULL;
+    h ^= h >> 29;
+    h *= 0xBF58476D1CE4E5B9ULL;
+    return h ^ (h >> 32);
+  }
+
+  // Head block of cell `k`, or kNone.
+  std::uint32_t find(const Key& k) const noexcept {
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = hash(k) & mask;; i = (i + 1) & mask) {
+      const Slot& s = slots_[i];
+      if (s.head == kNone) return kNone;
+      if (s.key == k) return s.head;
+    }
+  }
+  // Slot of cell `k`, created (with an empty block) when missing.
+  Slot& find_or_add(const Key& k) {
+    if (static_cast<double>(cells_ + 1) > config_.max_load_factor * double(slots_.size())) {
+      rehash(slots_.size() * 2);
+    }
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = hash(k) & mask;; i = (i + 1) & mask) {
+      Slot& s = slots_[i];
+      if (s.head == kNone) {
+        s.key = k;
+        s.head = new_block();
+        ++cells_;
+        return s;
+      }
+      if (s.key == k) return s;
+    }
+  }
+  void rehash(std::size_t capacity) {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(capacity, Slot{});
+    const std::size_t mask = capacity - 1;
+    for (const Slot& s : old) {
+      if (s.head == kNone) continue;
+      std::size_t i = hash(s.key) & mask;
+      while (slots_[i].head != kNone) i = (i + 1) & mask;
+      slots_[i] = s;
+    }
+  }
+  std::uint32_t new_block() {
+    if (!free_blocks_.empty()) {
+      const std::uint32_t b = free_blocks_.back();
+      free_blocks_.pop_back();
+      blocks_[b].count = 0;
+      blocks_[b].next = kNone;
+      return b;
+    }
+    blocks_.emplace_back();
+    return static_cast<std::uint32_t>(blocks_.size() - 1);
+  }
+
+  void place(PointId id, const Vec3<S>& p, const Key& key) {
+    Slot* slot = &find_or_add(key);
+    std::uint32_t bi = slot->head;
+    while (bi != kNone && blocks_[bi].count == kBlockCapacity) bi = blocks_[bi].next;
+    if (bi == kNone) {
+      bi = new_block();  // may reallocate blocks_, never slots_
+      blocks_[bi].next = slot->head;
+      slot->head = bi;
+    }
+    Block& b = blocks_[bi];
+    const std::uint32_t l = b.count++;
+    b.ids[l] = id;
+    b.x[l] = p.x();
+    b.y[l] = p.y();
+    b.z[l] = p.z();
+    loc_[id] = {bi, l};
+  }
+
+  // Takes `id` out of its block (stored in cell `key`); frees the block when it empties and
+  // is not the cell's only block.
+  void unlink(PointId id, const Key& key) {
+    const Loc at = loc_[id];
+    Block& b = blocks_[at.block];
+    const std::uint32_t last = --b.count;
+    if (at.lane != last) {
+      b.ids[at.lane] = b.ids[last];
+      b.x[at.lane] = b.x[last];
+      b.y[at.lane] = b.y[last];
+      b.z[at.lane] = b.z[last];
+      loc_[b.ids[at.lane]].lane = at.lane;
+    }
+    loc_[id] = Loc{};
+    if (b.count != 0) return;
+    const std::size_t mask = slots_.size() - 1;
+    std::size_t i = hash(key) & mask;
+    while (!(slots_[i].key == key)) i = (i + 1) & mask;
+    Slot& s = slots_[i];
+    if (s.head == at.block) {
+      if (b.next == kNone) return;  // the cell's only block stays, empty
+      s.head = b.next;
+    } else {
+      std::uint32_t prev = s.head;
+      while (blocks_[prev].next != at.block) prev = blocks_[prev].next;
+      blocks_[prev].next = b.next;
+    }
+    b.next = kNone;
+    free_blocks_.push_back(at.block);
+  }
+
+  template <class Visit>
+  void visit_cell(const Key& k, Visit& visit) const {
+    for (std::uint32_t bi = find(k); bi != kNone; bi = blocks_[bi].next) visit(blocks_[bi]);
+  }
+
+  Config config_;
+  S cell_ = S(1);
+  S inv_cell_ = S(1);
+  std::vector<Slot> slots_;
+  std::vector<Block> blocks_;
+  std::vector<std::uint32_t> free_blocks_;
+  std::vector<Loc> loc_;
+  std::size_t cells_ = 0;
+  std::size_t size_ = 0;
+};
+
+}  // namespace taxel::index
