@@ -3,3 +3,6 @@
 #pragma once
 
 #include "taxel/core.hpp"
+#include "taxel/fusion.hpp"
+#include "taxel/index.hpp"
+#include "taxel/sim.hpp"

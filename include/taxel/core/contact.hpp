@@ -72,6 +72,7 @@ enum class ContactDefect {
   asymmetric_covariance,   ///< covariance differs from its transpose beyond rounding
   indefinite_covariance,   ///< covariance is not positive definite
   bad_normal,              ///< normal is present but not finite or not of unit length (1e-3)
+  overflow,                ///< fusing it would overflow the model (extreme magnitudes)
 };
 
 /// Short description of a contact defect.
@@ -83,6 +84,7 @@ constexpr std::string_view to_string(ContactDefect d) noexcept {
     case ContactDefect::asymmetric_covariance: return "covariance is not symmetric";
     case ContactDefect::indefinite_covariance: return "covariance is not positive definite";
     case ContactDefect::bad_normal: return "normal is not a finite unit vector";
+    case ContactDefect::overflow: return "fusing it would overflow";
   }
   return "unknown";
 }
@@ -115,6 +117,18 @@ ContactDefect check_contact(const Contact<S>& c) noexcept {
     return ContactDefect::bad_normal;
   }
   return ContactDefect::ok;
+}
+
+/// `c` with its fields converted to scalar type T.
+template <Scalar T, Scalar S>
+Contact<T> contact_cast(const Contact<S>& c) {
+  Contact<T> out;
+  out.position = c.position.template cast<T>();
+  out.covariance = c.covariance.template cast<T>();
+  if (c.normal) out.normal = c.normal->template cast<T>();
+  out.pressure = static_cast<T>(c.pressure);
+  out.time = c.time;
+  return out;
 }
 
 }  // namespace taxel

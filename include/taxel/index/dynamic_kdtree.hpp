@@ -10,8 +10,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include <nanoflann.hpp>
-
 #include "taxel/core/assert.hpp"
 #include "taxel/index/concepts.hpp"
 #include "taxel/index/kdtree.hpp"

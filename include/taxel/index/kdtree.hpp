@@ -12,7 +12,16 @@
 #include <utility>
 #include <vector>
 
+// nanoflann 1.4 leaves root_bbox uninitialised until built; GCC's -Wmaybe-uninitialized
+// flags it inside nanoflann's own code.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <nanoflann.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 #include "taxel/core/assert.hpp"
 #include "taxel/core/point_cloud.hpp"

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+// Raw: the baseline that keeps every contact as its own point.
+#pragma once
+
+#include <cstdint>
+
+#include "taxel/core/contact.hpp"
+
+namespace taxel::fusion {
+
+/// Never merges: every valid contact becomes a point with the contact's position and
+/// measurement covariance (Meier et al. 2011, the "raw data" representation).
+/// State: 96 bytes (double), 48 (float).
+template <Scalar S>
+struct Raw {
+  using Scalar = S;
+  /// Raw has nothing to configure.
+  struct Config {};
+  /// A stored contact.
+  struct State {
+    Vec3<S> position;
+    Mat3<S> covariance;
+  };
+  static constexpr bool kMerges = false;
+
+  Raw() = default;
+  explicit Raw(const Config&) {}
+
+  /// The state of a contact.
+  State init(const Contact<S>& c) const { return {c.position, c.covariance}; }
+  /// Never merges; always false.
+  bool fuse(State&, const Contact<S>&, std::uint32_t) const { return false; }
+  /// The contact position [m].
+  const Vec3<S>& mean(const State& s) const noexcept { return s.position; }
+  /// The contact covariance [m^2].
+  const Mat3<S>& covariance(const State& s) const noexcept { return s.covariance; }
+};
+
+}  // namespace taxel::fusion

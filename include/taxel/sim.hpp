@@ -1,0 +1,6 @@
+// SPDX-License-Identifier: MIT
+// Umbrella header of taxel::sim.
+#pragma once
+
+#include "taxel/sim/shapes.hpp"
+#include "taxel/sim/sliding.hpp"

@@ -1,0 +1,361 @@
+// SPDX-License-Identifier: MIT
+// Tests of taxel::fusion: each policy against its defining property, and ContactCloud.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <new>
+#include <random>
+#include <taxel/fusion.hpp>
+#include <taxel/index.hpp>
+#include <taxel/sim.hpp>
+#include <vector>
+
+namespace tf = taxel::fusion;
+namespace ti = taxel::index;
+
+// Counts heap allocations so a test can prove a code path allocates nothing.
+namespace {
+std::atomic<long> g_allocations{0};
+}
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+template <class S>
+taxel::Contact<S> contact_at(const taxel::Vec3<S>& p, const taxel::Mat3<S>& cov, double t = 0) {
+  taxel::Contact<S> c;
+  c.position = p;
+  c.covariance = cov;
+  c.time = t;
+  return c;
+}
+
+// A random pad normal within `max_tilt` rad of +z.
+taxel::Vec3d random_normal(std::mt19937& rng, double max_tilt) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double tilt = max_tilt * u(rng), azimuth = 2 * M_PI * u(rng);
+  return {std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth), std::cos(tilt)};
+}
+
+// A contact of the true point `truth` seen by a pad with normal n: noise drawn from R.
+taxel::Contact<double> noisy_contact(std::mt19937& rng, const taxel::Vec3d& truth,
+                                     const taxel::Vec3d& n, double sn, double st) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  const taxel::Vec3d a = n.unitOrthogonal(), b = n.cross(a);
+  return contact_at<double>(truth + sn * g(rng) * n + st * g(rng) * a + st * g(rng) * b,
+                            taxel::pad_covariance(n, sn, st));
+}
+
+template <class M>
+bool symmetric_positive_definite(const M& m) {
+  if ((m - m.transpose()).cwiseAbs().maxCoeff() != 0) return false;
+  return Eigen::SelfAdjointEigenSolver<M>(m).eigenvalues().minCoeff() > 0;
+}
+
+}  // namespace
+
+TEMPLATE_TEST_CASE("Raw, Average and Kalman satisfy FusionPolicy", "[fusion]", float, double) {
+  STATIC_REQUIRE(tf::FusionPolicy<tf::Raw<TestType>>);
+  STATIC_REQUIRE(tf::FusionPolicy<tf::Average<TestType>>);
+  STATIC_REQUIRE(tf::FusionPolicy<tf::Kalman<TestType>>);
+  STATIC_REQUIRE_FALSE(tf::Raw<TestType>::kMerges);
+  STATIC_REQUIRE(tf::Kalman<TestType>::kMerges);
+}
+
+TEST_CASE("Raw keeps every valid contact as its own point", "[fusion]") {
+  const auto stream = taxel::sim::sliding_exploration(taxel::sim::Sphere(0.04), 5000);
+  tf::ContactCloud<tf::Raw<double>> cloud;
+  const auto r = cloud.insert(std::span(stream));
+  CHECK(r.added == stream.size());
+  CHECK(r.fused == 0);
+  REQUIRE(cloud.size() == stream.size());
+  for (std::size_t i = 0; i < stream.size(); i += 97) {
+    CHECK(cloud.mean(static_cast<ti::PointId>(i)) == stream[i].position);
+    CHECK(cloud.covariance(static_cast<ti::PointId>(i)) == stream[i].covariance);
+  }
+}
+
+TEMPLATE_TEST_CASE("Average is the arithmetic mean and does not depend on order", "[fusion]",
+                   float, double) {
+  using S = TestType;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g(0.0, 0.3e-3);
+  std::vector<taxel::Contact<S>> contacts;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d p(0.01 + g(rng), -0.02 + g(rng), 0.005 + g(rng));
+    sum += p;
+    contacts.push_back(
+        contact_at<S>(p.cast<S>(), taxel::isotropic_covariance<S>(S(1e-3)), i * 1e-3));
+  }
+  const Eigen::Vector3d mean = sum / 200.0;
+  const double tol = std::is_same_v<S, float> ? 1e-6 : 1e-15;
+
+  tf::ContactCloud<tf::Average<S>> cloud({.association_radius = S(5e-3)});
+  const auto r = cloud.insert(std::span<const taxel::Contact<S>>(contacts));
+  CHECK(r.added == 1);
+  CHECK(r.fused == 199);
+  REQUIRE(cloud.size() == 1);
+  CHECK((cloud.mean(0).template cast<double>() - mean).norm() < tol);
+  CHECK(cloud.observations(0) == 200);
+  CHECK(cloud.last_time(0) == Approx(0.199));
+  // The mean of 200 independent contacts with R = s^2 I has covariance s^2 I / 200.
+  CHECK(cloud.covariance(0)(0, 0) == Approx(1e-6 / 200).epsilon(1e-4));
+
+  std::shuffle(contacts.begin(), contacts.end(), rng);
+  tf::ContactCloud<tf::Average<S>> shuffled({.association_radius = S(5e-3)});
+  shuffled.insert(std::span<const taxel::Contact<S>>(contacts));
+  REQUIRE(shuffled.size() == 1);
+  CHECK((shuffled.mean(0).template cast<double>() - mean).norm() < tol);
+
+  SECTION("the exponential variant weights the newest contact by alpha") {
+    tf::Average<S> ema({.mode = tf::Average<S>::Mode::exponential, .alpha = S(0.25)});
+    auto state = ema.init(contact_at<S>(taxel::Vec3<S>::Zero(), contacts[0].covariance));
+    ema.fuse(state, contact_at<S>(taxel::Vec3<S>(S(4), S(0), S(0)), contacts[0].covariance), 1);
+    CHECK(state.mean.x() == Approx(1.0));
+    ema.fuse(state, contact_at<S>(taxel::Vec3<S>(S(4), S(0), S(0)), contacts[0].covariance), 2);
+    CHECK(state.mean.x() == Approx(1.75));
+  }
+}
+
+TEMPLATE_TEST_CASE("Kalman with Q = 0 and one isotropic R equals the cumulative average",
+                   "[fusion]", float, double) {
+  using S = TestType;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0.0, 1e-3);
+  const taxel::Mat3<S> R = taxel::isotropic_covariance<S>(S(1e-3));
+  tf::Kalman<S> kalman;
+  tf::Average<S> average;
+  const taxel::Contact<S> first = contact_at<S>(taxel::Vec3<S>::Zero(), R);
+  auto k = kalman.init(first);
+  auto a = average.init(first);
+  for (std::uint32_t n = 1; n < 2000; ++n) {
+    const auto c = contact_at<S>(Eigen::Vector3d(g(rng), g(rng), g(rng)).cast<S>(), R);
+    REQUIRE(kalman.fuse(k, c, n));
+    average.fuse(a, c, n);
+  }
+  const S tol = std::is_same_v<S, float> ? S(1e-8) : S(1e-16);
+  CHECK((k.mean - a.mean).norm() < tol);
+  // Both covariances are R / n.
+  CHECK(k.covariance(1, 1) == Approx(1e-6 / 2000).epsilon(1e-3));
+  CHECK(a.covariance(1, 1) == Approx(1e-6 / 2000).epsilon(1e-3));
+}
+
+TEST_CASE("Kalman beats Average with anisotropic pad covariances from several orientations",
+          "[fusion]") {
+  // Many trials: a true point observed by 20 contacts from pads tilted up to 60 degrees, 2 mm
+  // noise along each pad normal, 0.5 mm across. The Kalman mean is the best linear unbiased
+  // estimate; the average ignores the directions.
+  tf::Kalman<double> kalman;
+  tf::Average<double> average;
+  double sum_k = 0, sum_a = 0;
+  int kalman_wins = 0;
+  const int trials = 400;
+  for (int seed = 0; seed < trials; ++seed) {
+    std::mt19937 rng(static_cast<unsigned>(seed));
+    const taxel::Vec3d truth(0.01, 0.02, -0.03);
+    auto first = noisy_contact(rng, truth, random_normal(rng, M_PI / 3), 2e-3, 0.5e-3);
+    auto k = kalman.init(first);
+    auto a = average.init(first);
+    for (std::uint32_t n = 1; n < 20; ++n) {
+      const auto c = noisy_contact(rng, truth, random_normal(rng, M_PI / 3), 2e-3, 0.5e-3);
+      kalman.fuse(k, c, n);
+      average.fuse(a, c, n);
+    }
+    const double ek = (k.mean - truth).norm(), ea = (a.mean - truth).norm();
+    sum_k += ek;
+    sum_a += ea;
+    kalman_wins += ek < ea ? 1 : 0;
+  }
+  INFO("mean error Kalman " << sum_k / trials << " m, Average " << sum_a / trials << " m");
+  CHECK(sum_k < 0.8 * sum_a);
+  CHECK(kalman_wins > trials * 6 / 10);
+}
+
+TEMPLATE_TEST_CASE("Kalman covariance stays symmetric positive definite over 10^6 updates",
+                   "[fusion]", float, double) {
+  using S = TestType;
+  const S q = GENERATE(S(0), S(1e-5));
+  tf::Kalman<S> kalman({.process_noise = q});
+  std::mt19937 rng(17);
+  std::normal_distribution<double> g(0.0, 1.0);
+  auto state = kalman.init(contact_at<S>(taxel::Vec3<S>::Zero(),
+                                         taxel::pad_covariance<S>({0, 0, 1}, S(2e-3), S(1e-3))));
+  for (std::uint32_t n = 1; n <= 1000000; ++n) {
+    const taxel::Vec3d normal = random_normal(rng, M_PI / 2);
+    const double sn = 1e-3 * (0.5 + std::abs(g(rng)));
+    const auto c = contact_at<S>(Eigen::Vector3d(g(rng), g(rng), g(rng)).cast<S>() * S(1e-3),
+                                 taxel::pad_covariance<S>(normal.cast<S>(), S(sn), S(0.98e-3)));
+    kalman.fuse(state, c, n);
+    if (n % 100000 == 0) {
+      INFO("update " << n);
+      REQUIRE(symmetric_positive_definite(state.covariance));
+      REQUIRE(state.mean.allFinite());
+    }
+  }
+  if (q == S(0)) {
+    CHECK(state.covariance.trace() < S(1e-11));  // shrinks like 1/n
+    CHECK(state.mean.norm() < S(1e-5));          // and the mean converges on the truth
+  } else {
+    CHECK(state.covariance.trace() > S(1e-10));  // process noise keeps it open
+  }
+}
+
+TEST_CASE("the Mahalanobis gate refuses contacts the covariance rules out", "[fusion]") {
+  using Cloud = tf::ContactCloud<tf::Kalman<double>>;
+  Cloud gated({.association_radius = 5e-3,
+               .fusion = {.gate_chi2 = tf::kChi2Dof3P99}});
+  Cloud plain({.association_radius = 5e-3});
+  // 0.3 mm sigma along z: a contact 3 mm away along z is 10 sigma off, yet within 5 mm.
+  const auto R = taxel::pad_covariance<double>({0, 0, 1}, 0.3e-3, 2e-3);
+  for (Cloud* c : {&gated, &plain}) {
+    REQUIRE(c->insert(contact_at<double>({0, 0, 0}, R)).status == tf::InsertStatus::added);
+  }
+  CHECK(gated.insert(contact_at<double>({0, 0, 3e-3}, R)).status == tf::InsertStatus::added);
+  CHECK(plain.insert(contact_at<double>({0, 0, 3e-3}, R)).status == tf::InsertStatus::fused);
+  // 3 mm in the plane is 1.5 sigma: accepted.
+  CHECK(gated.insert(contact_at<double>({3e-3, 0, 0}, R)).status == tf::InsertStatus::fused);
+}
+
+TEMPLATE_TEST_CASE("ContactCloud gives identical clouds over every index", "[fusion]", float,
+                   double) {
+  using S = TestType;
+  const auto stream64 = taxel::sim::sliding_exploration(taxel::sim::Box(), 20000, {.seed = 4});
+  std::vector<taxel::Contact<S>> stream;
+  for (const auto& c : stream64) stream.push_back(taxel::contact_cast<S>(c));
+  const typename tf::ContactCloud<tf::Kalman<S>>::Config cfg{.association_radius = S(2e-3)};
+
+  tf::ContactCloud<tf::Kalman<S>, ti::BruteForce<S>> brute({cfg.association_radius});
+  tf::ContactCloud<tf::Kalman<S>, ti::VoxelHash<S>> voxel({cfg.association_radius});
+  tf::ContactCloud<tf::Kalman<S>, ti::DynamicKdTree<S>> kd({cfg.association_radius});
+  const std::span<const taxel::Contact<S>> all(stream);
+  const auto rb = brute.insert(all);
+  const auto rv = voxel.insert(all);
+  const auto rk = kd.insert(all);
+  CHECK(rb.added == rv.added);
+  CHECK(rb.added == rk.added);
+  CHECK(rb.fused == rv.fused);
+  CHECK(rb.fused > rb.added);  // the stream is redundant: most contacts fuse
+  REQUIRE(brute.size() == voxel.size());
+  REQUIRE(brute.size() == kd.size());
+  for (ti::PointId i = 0; i < brute.size(); ++i) {
+    REQUIRE(brute.mean(i) == voxel.mean(i));
+    REQUIRE(brute.mean(i) == kd.mean(i));
+    REQUIRE(brute.observations(i) == voxel.observations(i));
+    REQUIRE(brute.covariance(i) == kd.covariance(i));
+  }
+}
+
+TEST_CASE("ContactCloud rejects invalid contacts and stays unchanged", "[fusion]") {
+  tf::ContactCloud<> cloud({.association_radius = 3e-3});
+  const auto R = taxel::pad_covariance<double>({0, 0, 1}, 1e-3, 1e-3);
+  REQUIRE(cloud.insert(contact_at<double>({0, 0, 0}, R)).status == tf::InsertStatus::added);
+  REQUIRE(cloud.insert(contact_at<double>({1e-3, 0, 0}, R)).status == tf::InsertStatus::fused);
+  const auto before = cloud.to_point_cloud();
+  const auto cov_before = cloud.covariance(0);
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<taxel::Contact<double>, taxel::ContactDefect>> bad;
+  bad.push_back({contact_at<double>({nan, 0, 0}, R), taxel::ContactDefect::non_finite_position});
+  bad.push_back({contact_at<double>({0, inf, 0}, R), taxel::ContactDefect::non_finite_position});
+  auto c = contact_at<double>({0, 0, 0}, R);
+  c.covariance(2, 2) = inf;
+  bad.push_back({c, taxel::ContactDefect::non_finite_covariance});
+  c = contact_at<double>({0, 0, 0}, R);
+  c.covariance(0, 1) = 5e-7;
+  bad.push_back({c, taxel::ContactDefect::asymmetric_covariance});
+  c = contact_at<double>({0, 0, 0}, R);
+  c.covariance(1, 1) = -1e-6;
+  bad.push_back({c, taxel::ContactDefect::indefinite_covariance});
+  c = contact_at<double>({0, 0, 0}, taxel::Mat3d::Zero());
+  bad.push_back({c, taxel::ContactDefect::indefinite_covariance});
+
+  for (const auto& [contact, defect] : bad) {
+    const auto r = cloud.insert(contact);
+    CHECK(r.status == tf::InsertStatus::rejected);
+    CHECK(r.defect == defect);
+  }
+  const auto batch = cloud.insert(std::span<const taxel::Contact<double>>(
+      std::vector<taxel::Contact<double>>{bad[0].first, bad[3].first}));
+  CHECK(batch.rejected == 2);
+  const auto after = cloud.to_point_cloud();
+  REQUIRE(after.size() == before.size());
+  CHECK(after.points == before.points);
+  CHECK(after.fields[0].values == before.fields[0].values);
+  CHECK(cloud.covariance(0) == cov_before);
+}
+
+TEST_CASE("ContactCloud rejects bad configuration naming the field", "[fusion]") {
+  using Catch::Matchers::Contains;
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = 0}),
+                    Contains("association_radius"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = std::nan("")}),
+                    Contains("association_radius"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.process_noise = -1}}),
+                    Contains("process_noise"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.gate_chi2 = 0.0}}), Contains("gate_chi2"));
+  CHECK_THROWS_WITH(tf::ContactCloud<tf::Average<double>>(
+                        {.fusion = {.mode = tf::Average<double>::Mode::exponential,
+                                    .alpha = 1.5}}),
+                    Contains("alpha"));
+}
+
+TEST_CASE("ContactCloud exports, clears and fuses without allocating", "[fusion]") {
+  const auto stream = taxel::sim::sliding_exploration(taxel::sim::Cylinder(), 30000);
+  tf::ContactCloud<> cloud({.association_radius = 2e-3});
+  cloud.reserve(30000);
+  cloud.insert(std::span(stream).first(20000));
+
+  // Replay contacts that land on existing points: every insert fuses; count allocations.
+  long fused = 0, allocations = 0;
+  for (std::size_t i = 20000; i < stream.size(); ++i) {
+    const long before = g_allocations.load();
+    const auto r = cloud.insert(stream[i]);
+    const long delta = g_allocations.load() - before;
+    if (r.status == tf::InsertStatus::fused) {
+      ++fused;
+      allocations += delta;
+    }
+  }
+  CHECK(fused > 5000);
+  CHECK(allocations == 0);
+
+  const auto pc = cloud.to_point_cloud();
+  CHECK(pc.validate().ok());
+  CHECK(pc.size() == cloud.size());
+  REQUIRE(pc.field("observations") != nullptr);
+  double total = 0;
+  for (double v : pc.field("observations")->values) total += v;
+  CHECK(total == Approx(30000));  // every contact counted once
+  CHECK(cloud.memory_bytes() > cloud.size() * sizeof(tf::Kalman<double>::State));
+  cloud.clear();
+  CHECK(cloud.empty());
+  CHECK(cloud.insert(stream[0]).status == tf::InsertStatus::added);
+}
+
+TEST_CASE("fused clouds are compact and closer to the surface than raw contacts", "[fusion]") {
+  const taxel::sim::Sphere sphere(0.04);
+  const auto stream = taxel::sim::sliding_exploration(sphere, 50000, {.seed = 8});
+  tf::ContactCloud<tf::Raw<double>> raw({.association_radius = 3.4e-3});
+  tf::ContactCloud<tf::Kalman<double>> kalman({.association_radius = 3.4e-3});
+  raw.insert(std::span(stream));
+  kalman.insert(std::span(stream));
+  const auto raw_err = taxel::sim::surface_error(sphere, raw.to_point_cloud().points);
+  const auto k_err = taxel::sim::surface_error(sphere, kalman.to_point_cloud().points);
+  INFO("raw " << raw.size() << " pts rms " << raw_err.rms << "; kalman " << kalman.size()
+              << " pts rms " << k_err.rms);
+  CHECK(kalman.size() * 10 < raw.size());
+  CHECK(k_err.rms < raw_err.rms);
+}
