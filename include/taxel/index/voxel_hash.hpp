@@ -56,7 +56,8 @@ class VoxelHash {
       throw std::invalid_argument("VoxelHash::Config::max_load_factor must be in (0, 0.9], got " +
                                   std::to_string(config.max_load_factor));
     }
-    cell_ = S(2) * probe_radius(radius) * (S(1) + S(16) * kEps);
+    radius_ = radius;
+    cell_ = S(2) * radius * (S(1) + kMargin);
     inv_cell_ = S(1) / cell_;
     slots_.assign(16, Slot{});
   }
@@ -138,6 +139,10 @@ class VoxelHash {
   /// The closest point within distance r of q (ties by id), if any. No allocation.
   [[nodiscard]] std::optional<Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
     if (size_ == 0 || !q.allFinite() || !(r >= S(0))) return std::nullopt;
+    const Vec3<S> t = q * inv_cell_;
+    if (r <= radius_ && t.cwiseAbs().maxCoeff() * S(8) * kEps < kMargin) {
+      return nearest_in_block(q, t, r);
+    }
     const S rp = probe_radius(r);
     const Key lo = key_of(Vec3<S>(q.array() - rp));
     const Key hi = key_of(Vec3<S>(q.array() + rp));
@@ -145,11 +150,14 @@ class VoxelHash {
     Neighbor<S> best{0, r * r};
     bool found = false;
     auto visit = [&](const Block& b) {
-      for (std::uint32_t l = 0; l < b.count; ++l) {
-        const Neighbor<S> n{b.ids[l], squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q)};
-        if (n.squared_distance < best.squared_distance ||
-            (n.squared_distance == best.squared_distance && (!found || n.id < best.id))) {
-          best = n;
+      S d2[kBlockCapacity];
+      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {  // fixed trip count: vectorises
+        d2[l] = squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q);
+      }
+      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
+        if (d2[l] < best.squared_distance ||
+            (d2[l] == best.squared_distance && (!found || b.ids[l] < best.id))) {
+          best = {b.ids[l], d2[l]};
           found = true;
         }
       }
@@ -225,6 +233,10 @@ class VoxelHash {
   static constexpr S kEps = std::numeric_limits<S>::epsilon();
   // Cell coordinates are clamped so they fit int32 and are exactly representable in float.
   static constexpr S kMaxCell = S(1 << 30);
+  // Cells are 2 r (1 + kMargin) wide, so a ball of radius r around q reaches at most one
+  // neighbour cell per axis, the one on the side of q's cell centre, with kMargin of cell
+  // width to spare for rounding (used while |q / cell| * 8 eps < kMargin).
+  static constexpr S kMargin = S(1e-4);
 
   struct Key {
     std::int32_t x = 0, y = 0, z = 0;
@@ -234,11 +246,19 @@ class VoxelHash {
     Key key;
     std::uint32_t head = kNone;  // kNone: never used (ends a probe run)
   };
+  // Unused lanes hold +inf coordinates, so a scan over all lanes needs no count check and
+  // an unused lane is never within any radius.
   struct Block {
     std::uint32_t count = 0;
     std::uint32_t next = kNone;
-    PointId ids[kBlockCapacity];
+    PointId ids[kBlockCapacity] = {};
     S x[kBlockCapacity], y[kBlockCapacity], z[kBlockCapacity];
+    Block() noexcept { clear_lanes(0); }
+    void clear_lanes(std::uint32_t from) noexcept {
+      for (std::uint32_t l = from; l < kBlockCapacity; ++l) {
+        x[l] = y[l] = z[l] = std::numeric_limits<S>::infinity();
+      }
+    }
   };
   struct Loc {
     std::uint32_t block = kNone;
@@ -250,9 +270,11 @@ class VoxelHash {
   // and the stored coordinate is representable (cell_of(fl(q - rp)) <= cell_of(p)).
   static S probe_radius(S r) noexcept { return r * (S(1) + S(16) * kEps); }
 
+  // floor(v / cell), clamped to +-2^30; without a libm call (x86-64 baseline has no roundsd).
   std::int32_t cell_of(S v) const noexcept {
-    const S c = std::clamp(std::floor(v * inv_cell_), -kMaxCell, kMaxCell);
-    return static_cast<std::int32_t>(c);
+    const S t = std::min(std::max(v * inv_cell_, -kMaxCell), kMaxCell);
+    const auto i = static_cast<std::int32_t>(t);
+    return i - static_cast<std::int32_t>(t < static_cast<S>(i));
   }
   Key key_of(const Vec3<S>& p) const noexcept {
     return {cell_of(p.x()), cell_of(p.y()), cell_of(p.z())};
@@ -320,6 +342,7 @@ class VoxelHash {
       free_blocks_.pop_back();
       blocks_[b].count = 0;
       blocks_[b].next = kNone;
+      blocks_[b].clear_lanes(0);
       return b;
     }
     blocks_.emplace_back();
@@ -327,10 +350,10 @@ class VoxelHash {
   }
 
   void place(PointId id, const Vec3<S>& p, const Key& key) {
+    // Invariant: in a cell's chain only the head block may be partly filled.
     Slot* slot = &find_or_add(key);
     std::uint32_t bi = slot->head;
-    while (bi != kNone && blocks_[bi].count == kBlockCapacity) bi = blocks_[bi].next;
-    if (bi == kNone) {
+    if (blocks_[bi].count == kBlockCapacity) {
       bi = new_block();  // may reallocate blocks_, never slots_
       blocks_[bi].next = slot->head;
       slot->head = bi;
@@ -344,35 +367,73 @@ class VoxelHash {
     loc_[id] = {bi, l};
   }
 
-  // Takes `id` out of its block (stored in cell `key`); frees the block when it empties and
-  // is not the cell's only block.
+  // Takes `id` out of cell `key`, filling its lane with the last point of the cell's head
+  // block (keeping only the head partly filled); frees the head when it empties and is not
+  // the cell's only block.
   void unlink(PointId id, const Key& key) {
-    const Loc at = loc_[id];
-    Block& b = blocks_[at.block];
-    const std::uint32_t last = --b.count;
-    if (at.lane != last) {
-      b.ids[at.lane] = b.ids[last];
-      b.x[at.lane] = b.x[last];
-      b.y[at.lane] = b.y[last];
-      b.z[at.lane] = b.z[last];
-      loc_[b.ids[at.lane]].lane = at.lane;
-    }
-    loc_[id] = Loc{};
-    if (b.count != 0) return;
     const std::size_t mask = slots_.size() - 1;
     std::size_t i = hash(key) & mask;
-    while (!(slots_[i].key == key)) i = (i + 1) & mask;
-    Slot& s = slots_[i];
-    if (s.head == at.block) {
-      if (b.next == kNone) return;  // the cell's only block stays, empty
-      s.head = b.next;
-    } else {
-      std::uint32_t prev = s.head;
-      while (blocks_[prev].next != at.block) prev = blocks_[prev].next;
-      blocks_[prev].next = b.next;
+    while (!(slots_[i].key == key) || slots_[i].head == kNone) i = (i + 1) & mask;
+    Slot& slot = slots_[i];
+    const Loc at = loc_[id];
+    Block& head = blocks_[slot.head];
+    const std::uint32_t last = --head.count;
+    if (slot.head != at.block || at.lane != last) {
+      Block& b = blocks_[at.block];
+      b.ids[at.lane] = head.ids[last];
+      b.x[at.lane] = head.x[last];
+      b.y[at.lane] = head.y[last];
+      b.z[at.lane] = head.z[last];
+      loc_[b.ids[at.lane]] = at;
     }
-    b.next = kNone;
-    free_blocks_.push_back(at.block);
+    head.clear_lanes(last);
+    loc_[id] = Loc{};
+    if (head.count == 0 && head.next != kNone) {
+      const std::uint32_t freed = slot.head;
+      slot.head = head.next;
+      head.next = kNone;
+      free_blocks_.push_back(freed);
+    }
+  }
+
+  // nearest_within for r <= radius_: the query's cell, then those of its 7 neighbours on the
+  // sides of the cell centre it is closest to, skipping any that lie farther than the best.
+  std::optional<Neighbor<S>> nearest_in_block(const Vec3<S>& q, const Vec3<S>& t, S r) const {
+    Neighbor<S> best{0, r * r};
+    bool found = false;
+    auto visit = [&](const Block& b) {
+      S d2[kBlockCapacity];
+      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
+        d2[l] = squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q);
+      }
+      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
+        if (d2[l] < best.squared_distance ||
+            (d2[l] == best.squared_distance && (!found || b.ids[l] < best.id))) {
+          best = {b.ids[l], d2[l]};
+          found = true;
+        }
+      }
+    };
+    const Key home = key_of(q);
+    std::int32_t step[3];
+    S gap2[3];
+    for (int a = 0; a < 3; ++a) {
+      const S frac = t[a] - static_cast<S>((&home.x)[a]);
+      step[a] = frac < S(0.5) ? -1 : 1;
+      // Distance to the neighbour cell's face, less kMargin of a cell for rounding.
+      const S gap = std::max(S(0), (step[a] < 0 ? frac : S(1) - frac) - kMargin) * cell_;
+      gap2[a] = gap * gap;
+    }
+    visit_cell(home, visit);
+    for (int m = 1; m < 8; ++m) {
+      const S g2 = ((m & 1) ? gap2[0] : S(0)) + ((m & 2) ? gap2[1] : S(0)) +
+                   ((m & 4) ? gap2[2] : S(0));
+      if (g2 > best.squared_distance) continue;
+      visit_cell(Key{home.x + ((m & 1) ? step[0] : 0), home.y + ((m & 2) ? step[1] : 0),
+                     home.z + ((m & 4) ? step[2] : 0)},
+                 visit);
+    }
+    return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
   }
 
   template <class Visit>
@@ -381,6 +442,7 @@ class VoxelHash {
   }
 
   Config config_;
+  S radius_ = S(1);
   S cell_ = S(1);
   S inv_cell_ = S(1);
   std::vector<Slot> slots_;

@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: MIT
+// Contact fusion end to end (nearest within radius + policy update + index move, or insert)
+// for every policy x index, on 200k-contact sliding explorations of a sphere, a cylinder and a
+// box; plus query-only replay and a 100k-point growth case. Peers in the same binary:
+// nanoflann's dynamic adaptor (DynamicKdTree) and brute force.
+//   ./fusion_bench --benchmark_filter=Fuse/Kalman
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <random>
+#include <string>
+#include <taxel/fusion.hpp>
+#include <taxel/index.hpp>
+#include <taxel/sim.hpp>
+#include <vector>
+
+namespace tf = taxel::fusion;
+namespace ti = taxel::index;
+
+namespace {
+
+constexpr std::size_t kStream = 200000;
+constexpr double kRadius = 2e-3;
+
+enum class ShapeId { sphere, cylinder, box };
+
+template <class S>
+const std::vector<taxel::Contact<S>>& stream(ShapeId shape) {
+  static std::map<ShapeId, std::vector<taxel::Contact<S>>> cache;
+  auto& s = cache[shape];
+  if (s.empty()) {
+    std::vector<taxel::Contact<double>> c;
+    const taxel::sim::SlidingConfig cfg{.seed = 42};
+    switch (shape) {
+      case ShapeId::sphere: c = taxel::sim::sliding_exploration(taxel::sim::Sphere(0.04), kStream, cfg); break;
+      case ShapeId::cylinder: c = taxel::sim::sliding_exploration(taxel::sim::Cylinder(0.03, 0.05), kStream, cfg); break;
+      case ShapeId::box: c = taxel::sim::sliding_exploration(taxel::sim::Box(), kStream, cfg); break;
+    }
+    for (const auto& x : c) s.push_back(taxel::contact_cast<S>(x));
+  }
+  return s;
+}
+
+// End to end: a fresh cloud per iteration, the whole stream inserted.
+template <class Policy, class Index>
+void Fuse(benchmark::State& state) {
+  using S = typename Policy::Scalar;
+  const auto& contacts = stream<S>(static_cast<ShapeId>(state.range(0)));
+  std::size_t points = 0, bytes = 0, fused = 0;
+  for (auto _ : state) {
+    tf::ContactCloud<Policy, Index> cloud({.association_radius = S(kRadius)});
+    for (const auto& c : contacts) benchmark::DoNotOptimize(cloud.insert(c));
+    points = cloud.size();
+    bytes = cloud.memory_bytes();
+    fused = contacts.size() - points;
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * contacts.size()));
+  state.counters["ns_per_contact"] = benchmark::Counter(
+      static_cast<double>(state.iterations() * contacts.size()),
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["points"] = static_cast<double>(points);
+  state.counters["bytes_per_point"] = static_cast<double>(bytes) / static_cast<double>(points);
+  state.counters["fused_pct"] = 100.0 * static_cast<double>(fused) / double(contacts.size());
+}
+
+// Query only: nearest_within for every contact against a finished cloud's index.
+template <class Index>
+void QueryReplay(benchmark::State& state) {
+  using S = typename Index::Scalar;
+  const auto& contacts = stream<S>(static_cast<ShapeId>(state.range(0)));
+  tf::ContactCloud<tf::Kalman<S>, Index> cloud({.association_radius = S(kRadius)});
+  for (const auto& c : contacts) cloud.insert(c);
+  for (auto _ : state) {
+    for (const auto& c : contacts) {
+      benchmark::DoNotOptimize(cloud.index().nearest_within(c.position, S(kRadius)));
+    }
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * contacts.size()));
+  state.counters["points"] = static_cast<double>(cloud.size());
+}
+
+// Growth: 100k contacts spread over a 0.5 m cube, almost all of them new points.
+template <class Index>
+void Growth(benchmark::State& state) {
+  using S = typename Index::Scalar;
+  std::vector<taxel::Contact<S>> contacts(100000);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<S> u(S(-0.25), S(0.25));
+  for (auto& c : contacts) c.position = {u(rng), u(rng), u(rng)};
+  std::size_t points = 0;
+  for (auto _ : state) {
+    tf::ContactCloud<tf::Kalman<S>, Index> cloud({.association_radius = S(kRadius)});
+    for (const auto& c : contacts) benchmark::DoNotOptimize(cloud.insert(c));
+    points = cloud.size();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * contacts.size()));
+  state.counters["points"] = static_cast<double>(points);
+}
+
+void Shapes(benchmark::internal::Benchmark* b) {
+  b->ArgName("shape")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace
+
+// One line per combination; a new policy or index is one more line.
+BENCHMARK_TEMPLATE(Fuse, tf::Kalman<double>, ti::VoxelHash<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Fuse, tf::Kalman<float>, ti::VoxelHash<float>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Fuse, tf::Kalman<double>, ti::DynamicKdTree<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Fuse, tf::Kalman<double>, ti::BruteForce<double>)->Apply(Shapes)->Iterations(1);
+BENCHMARK_TEMPLATE(Fuse, tf::Average<double>, ti::VoxelHash<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Fuse, tf::Average<double>, ti::DynamicKdTree<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Fuse, tf::Average<double>, ti::BruteForce<double>)->Apply(Shapes)->Iterations(1);
+BENCHMARK_TEMPLATE(Fuse, tf::Raw<double>, ti::VoxelHash<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Fuse, tf::Raw<double>, ti::DynamicKdTree<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Fuse, tf::Raw<double>, ti::BruteForce<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(QueryReplay, ti::VoxelHash<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(QueryReplay, ti::DynamicKdTree<double>)->Apply(Shapes);
+BENCHMARK_TEMPLATE(Growth, ti::VoxelHash<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(Growth, ti::DynamicKdTree<double>)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
