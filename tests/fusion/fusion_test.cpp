@@ -15,7 +15,15 @@
 namespace tf = taxel::fusion;
 namespace ti = taxel::index;
 
-// Counts heap allocations so a test can prove a code path allocates nothing.
+// Counts heap allocations so a test can prove a code path allocates nothing. AddressSanitizer
+// owns operator new itself, so the count is off (and the check skipped) under it.
+#if defined(__SANITIZE_ADDRESS__)
+#define TAXEL_TEST_COUNTS_ALLOCATIONS 0
+namespace {
+std::atomic<long> g_allocations{0};
+}
+#else
+#define TAXEL_TEST_COUNTS_ALLOCATIONS 1
 namespace {
 std::atomic<long> g_allocations{0};
 }
@@ -29,6 +37,7 @@ void* operator new(std::size_t n) {
 }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#endif
 
 namespace {
 
@@ -330,7 +339,11 @@ TEST_CASE("ContactCloud exports, clears and fuses without allocating", "[fusion]
     }
   }
   CHECK(fused > 5000);
-  CHECK(allocations == 0);
+  if (TAXEL_TEST_COUNTS_ALLOCATIONS) {
+    CHECK(allocations == 0);
+  } else {
+    WARN("allocation count not checked under AddressSanitizer");
+  }
 
   const auto pc = cloud.to_point_cloud();
   CHECK(pc.validate().ok());

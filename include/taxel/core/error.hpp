@@ -36,10 +36,14 @@ class IoError : public std::runtime_error {
   static std::string format(const std::string& source, const std::string& reason,
                             std::optional<std::uint64_t> line,
                             std::optional<std::uint64_t> byte_offset) {
-    std::string s = source;
-    if (line) s += ":" + std::to_string(*line);
-    if (byte_offset) s += ": byte " + std::to_string(*byte_offset);
-    return s + ": " + reason;
+    // append() rather than operator+: GCC 12 misreports -Wstringop-overflow on the latter.
+    std::string s;
+    s.reserve(source.size() + reason.size() + 32);
+    s.append(source);
+    if (line) s.append(":").append(std::to_string(*line));
+    if (byte_offset) s.append(": byte ").append(std::to_string(*byte_offset));
+    s.append(": ").append(reason);
+    return s;
   }
 
   std::string source_;
