@@ -32,9 +32,15 @@ const std::vector<taxel::Contact<S>>& stream(ShapeId shape) {
     std::vector<taxel::Contact<double>> c;
     const taxel::sim::SlidingConfig cfg{.seed = 42};
     switch (shape) {
-      case ShapeId::sphere: c = taxel::sim::sliding_exploration(taxel::sim::Sphere(0.04), kStream, cfg); break;
-      case ShapeId::cylinder: c = taxel::sim::sliding_exploration(taxel::sim::Cylinder(0.03, 0.05), kStream, cfg); break;
-      case ShapeId::box: c = taxel::sim::sliding_exploration(taxel::sim::Box(), kStream, cfg); break;
+      case ShapeId::sphere:
+        c = taxel::sim::sliding_exploration(taxel::sim::Sphere(0.04), kStream, cfg);
+        break;
+      case ShapeId::cylinder:
+        c = taxel::sim::sliding_exploration(taxel::sim::Cylinder(0.03, 0.05), kStream, cfg);
+        break;
+      case ShapeId::box:
+        c = taxel::sim::sliding_exploration(taxel::sim::Box(), kStream, cfg);
+        break;
     }
     for (const auto& x : c) s.push_back(taxel::contact_cast<S>(x));
   }
@@ -56,9 +62,9 @@ void Fuse(benchmark::State& state) {
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * contacts.size()));
-  state.counters["ns_per_contact"] = benchmark::Counter(
-      static_cast<double>(state.iterations() * contacts.size()),
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_contact"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * contacts.size()),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["points"] = static_cast<double>(points);
   state.counters["bytes_per_point"] = static_cast<double>(bytes) / static_cast<double>(points);
   state.counters["fused_pct"] = 100.0 * static_cast<double>(fused) / double(contacts.size());

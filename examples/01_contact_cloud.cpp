@@ -27,20 +27,20 @@ void run(const char* policy, const char* index, const Shape& shape,
     if (pc.field("observations")->values[i] >= 5) confirmed.push_back(pc.points[i]);
   }
   const auto conf = taxel::sim::surface_error(shape, confirmed);
-  std::printf("  %-8s %-13s %8zu points  %6.1fx  rms %5.3f mm  max %5.2f mm | n>=5: %6zu pts "
-              "rms %5.3f mm | %5.0f ns/contact  rejected %zu\n",
-              policy, index, cloud.size(),
-              static_cast<double>(contacts.size()) / static_cast<double>(cloud.size()),
-              err.rms * 1e3, err.max * 1e3, confirmed.size(), conf.rms * 1e3,
-              seconds * 1e9 / static_cast<double>(contacts.size()), counts.rejected);
+  std::printf(
+      "  %-8s %-13s %8zu points  %6.1fx  rms %5.3f mm  max %5.2f mm | n>=5: %6zu pts "
+      "rms %5.3f mm | %5.0f ns/contact  rejected %zu\n",
+      policy, index, cloud.size(),
+      static_cast<double>(contacts.size()) / static_cast<double>(cloud.size()), err.rms * 1e3,
+      err.max * 1e3, confirmed.size(), conf.rms * 1e3,
+      seconds * 1e9 / static_cast<double>(contacts.size()), counts.rejected);
 }
 
 template <class Shape>
 void study(const char* name, const Shape& shape, std::size_t n) {
   // A 3.4 mm-pitch pad sliding at 20 mm/s, 1 kHz, 1 mm noise along its normal, and 0.2 rad
   // of kinematic tilt noise, so that contacts reach a point from varied pad orientations.
-  const auto contacts =
-      taxel::sim::sliding_exploration(shape, n, {.sigma_tilt = 0.2, .seed = 7});
+  const auto contacts = taxel::sim::sliding_exploration(shape, n, {.sigma_tilt = 0.2, .seed = 7});
   std::printf("%s: %zu contacts\n", name, contacts.size());
   namespace tf = taxel::fusion;
   namespace ti = taxel::index;
@@ -59,9 +59,10 @@ int main(int argc, char** argv) {
     if (arg == "--quick") {
       quick = true;
     } else if (arg == "--help" || arg == "-h") {
-      std::puts("usage: 01_contact_cloud [--quick]\n"
-                "Fuses simulated sliding explorations with Raw, Average and Kalman policies and\n"
-                "prints point counts and distances to the true surface.");
+      std::puts(
+          "usage: 01_contact_cloud [--quick]\n"
+          "Fuses simulated sliding explorations with Raw, Average and Kalman policies and\n"
+          "prints point counts and distances to the true surface.");
       return 0;
     } else {
       std::fprintf(stderr, "01_contact_cloud: unknown argument '%s' (try --help)\n", argv[i]);

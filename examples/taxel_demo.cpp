@@ -38,8 +38,8 @@ bool fuse_row(const char* shape_name, const char* policy_name, const Shape& shap
   cloud.insert(std::span(contacts));
   const auto pc = cloud.to_point_cloud();
   const auto err = taxel::sim::surface_error(shape, pc.points);
-  std::printf("| %-9s | %-8s | %8zu | %7.1fx | %6.3f | %6.3f | %6.2f |\n", shape_name,
-              policy_name, cloud.size(),
+  std::printf("| %-9s | %-8s | %8zu | %7.1fx | %6.3f | %6.3f | %6.2f |\n", shape_name, policy_name,
+              cloud.size(),
               static_cast<double>(contacts.size()) / static_cast<double>(cloud.size()),
               err.mean * 1e3, err.rms * 1e3, err.max * 1e3);
   const auto file = dir / (std::string(shape_name) + "_" + policy_name + ".ply");
@@ -53,8 +53,7 @@ bool fuse_row(const char* shape_name, const char* policy_name, const Shape& shap
 template <class Shape>
 bool shape_rows(const char* name, const Shape& shape, std::size_t n,
                 const std::filesystem::path& dir) {
-  const auto contacts =
-      taxel::sim::sliding_exploration(shape, n, {.sigma_tilt = 0.2, .seed = 3});
+  const auto contacts = taxel::sim::sliding_exploration(shape, n, {.sigma_tilt = 0.2, .seed = 3});
   return fuse_row<tf::Raw<double>>(name, "raw", shape, contacts, dir) &&
          fuse_row<tf::Average<double>>(name, "average", shape, contacts, dir) &&
          fuse_row<tf::Kalman<double>>(name, "kalman", shape, contacts, dir);
@@ -70,10 +69,11 @@ int main(int argc, char** argv) {
     if (arg == "--quick") {
       quick = true;
     } else if (arg == "--help" || arg == "-h") {
-      std::puts("usage: taxel-demo [--quick] [output-folder]   (default taxel-demo-output)\n"
-                "Fuses simulated sliding explorations of a sphere, a cylinder and a box with the\n"
-                "raw, averaging and Kalman policies, prints accuracy and compaction, and writes\n"
-                "the fused clouds as PLY files.");
+      std::puts(
+          "usage: taxel-demo [--quick] [output-folder]   (default taxel-demo-output)\n"
+          "Fuses simulated sliding explorations of a sphere, a cylinder and a box with the\n"
+          "raw, averaging and Kalman policies, prints accuracy and compaction, and writes\n"
+          "the fused clouds as PLY files.");
       return 0;
     } else if (!arg.empty() && arg[0] == '-') {
       std::fprintf(stderr, "taxel-demo: unknown option '%s' (try --help)\n", argv[i]);

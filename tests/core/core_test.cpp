@@ -42,7 +42,8 @@ TEST_CASE("pad_covariance rejects a zero normal and non-positive sigmas") {
   CHECK_THROWS_WITH(taxel::pad_covariance(V(0, 0, std::nan("")), 1e-3, 1e-3), Contains("normal"));
   CHECK_THROWS_WITH(taxel::pad_covariance(V(0, 0, 1), 0.0, 1e-3), Contains("sigma"));
   CHECK_THROWS_WITH(taxel::pad_covariance(V(0, 0, 1), 1e-3, -1.0), Contains("sigma"));
-  CHECK_THROWS_AS(taxel::pad_covariance(V(0, 0, 1), 1e-3, std::numeric_limits<double>::infinity()), std::invalid_argument);
+  CHECK_THROWS_AS(taxel::pad_covariance(V(0, 0, 1), 1e-3, std::numeric_limits<double>::infinity()),
+                  std::invalid_argument);
   CHECK_THROWS_AS(taxel::isotropic_covariance(0.0), std::invalid_argument);
   CHECK(taxel::isotropic_covariance(2.0)(1, 1) == 4.0);
 }

@@ -95,8 +95,8 @@ TEST_CASE("Raw keeps every valid contact as its own point", "[fusion]") {
   }
 }
 
-TEMPLATE_TEST_CASE("Average is the arithmetic mean and does not depend on order", "[fusion]",
-                   float, double) {
+TEMPLATE_TEST_CASE("Average is the arithmetic mean and does not depend on order", "[fusion]", float,
+                   double) {
   using S = TestType;
   std::mt19937 rng(3);
   std::normal_distribution<double> g(0.0, 0.3e-3);
@@ -199,8 +199,8 @@ TEMPLATE_TEST_CASE("Kalman covariance stays symmetric positive definite over 10^
   tf::Kalman<S> kalman({.process_noise = q});
   std::mt19937 rng(17);
   std::normal_distribution<double> g(0.0, 1.0);
-  auto state = kalman.init(contact_at<S>(taxel::Vec3<S>::Zero(),
-                                         taxel::pad_covariance<S>({0, 0, 1}, S(2e-3), S(1e-3))));
+  auto state = kalman.init(
+      contact_at<S>(taxel::Vec3<S>::Zero(), taxel::pad_covariance<S>({0, 0, 1}, S(2e-3), S(1e-3))));
   for (std::uint32_t n = 1; n <= 1000000; ++n) {
     const taxel::Vec3d normal = random_normal(rng, M_PI / 2);
     const double sn = 1e-3 * (0.5 + std::abs(g(rng)));
@@ -223,8 +223,7 @@ TEMPLATE_TEST_CASE("Kalman covariance stays symmetric positive definite over 10^
 
 TEST_CASE("the Mahalanobis gate refuses contacts the covariance rules out", "[fusion]") {
   using Cloud = tf::ContactCloud<tf::Kalman<double>>;
-  Cloud gated({.association_radius = 5e-3,
-               .fusion = {.gate_chi2 = tf::kChi2Dof3P99}});
+  Cloud gated({.association_radius = 5e-3, .fusion = {.gate_chi2 = tf::kChi2Dof3P99}});
   Cloud plain({.association_radius = 5e-3});
   // 0.3 mm sigma along z: a contact 3 mm away along z is 10 sigma off, yet within 5 mm.
   const auto R = taxel::pad_covariance<double>({0, 0, 1}, 0.3e-3, 2e-3);
@@ -308,16 +307,14 @@ TEST_CASE("ContactCloud rejects invalid contacts and stays unchanged", "[fusion]
 
 TEST_CASE("ContactCloud rejects bad configuration naming the field", "[fusion]") {
   using Catch::Matchers::Contains;
-  CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = 0}),
-                    Contains("association_radius"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = 0}), Contains("association_radius"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = std::nan("")}),
                     Contains("association_radius"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.process_noise = -1}}),
                     Contains("process_noise"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.gate_chi2 = 0.0}}), Contains("gate_chi2"));
   CHECK_THROWS_WITH(tf::ContactCloud<tf::Average<double>>(
-                        {.fusion = {.mode = tf::Average<double>::Mode::exponential,
-                                    .alpha = 1.5}}),
+                        {.fusion = {.mode = tf::Average<double>::Mode::exponential, .alpha = 1.5}}),
                     Contains("alpha"));
 }
 

@@ -49,8 +49,8 @@ taxel::Vec3<S> jitter(std::mt19937& rng, const taxel::Vec3<S>& c, double scale) 
 }  // namespace
 
 TEMPLATE_TEST_CASE("every incremental index matches BruteForce after inserts, moves and erases",
-                   "[index]", ti::VoxelHash<float>, ti::VoxelHash<double>,
-                   ti::DynamicKdTree<float>, ti::DynamicKdTree<double>) {
+                   "[index]", ti::VoxelHash<float>, ti::VoxelHash<double>, ti::DynamicKdTree<float>,
+                   ti::DynamicKdTree<double>) {
   using I = TestType;
   using S = typename I::Scalar;
   using V = taxel::Vec3<S>;
@@ -141,7 +141,8 @@ TEMPLATE_TEST_CASE("every incremental index matches BruteForce after inserts, mo
         expect_same_answers(index, oracle, where[step % where.size()]);
       }
     }
-    for (std::size_t id = 0; id < where.size(); ++id) CHECK(index.contains(static_cast<ti::PointId>(id)) == alive[id]);
+    for (std::size_t id = 0; id < where.size(); ++id)
+      CHECK(index.contains(static_cast<ti::PointId>(id)) == alive[id]);
     index.clear();
     CHECK(index.size() == 0);
     CHECK_FALSE(index.nearest_within(centre, S(1)).has_value());

@@ -39,8 +39,8 @@ inline std::atomic<AssertHandler>& assert_handler_slot() noexcept {
 /// Installs `handler` (nullptr restores the default, which throws AssertionError) and returns
 /// the previous one. Thread-safe.
 inline AssertHandler set_assert_handler(AssertHandler handler) noexcept {
-  return detail::assert_handler_slot().exchange(
-      handler ? handler : &detail::default_assert_handler, std::memory_order_acq_rel);
+  return detail::assert_handler_slot().exchange(handler ? handler : &detail::default_assert_handler,
+                                                std::memory_order_acq_rel);
 }
 
 }  // namespace taxel
@@ -49,11 +49,11 @@ inline AssertHandler set_assert_handler(AssertHandler handler) noexcept {
 /// TAXEL_ENABLE_ASSERTS to keep it in release builds or TAXEL_DISABLE_ASSERTS to drop it always.
 #if (!defined(NDEBUG) || defined(TAXEL_ENABLE_ASSERTS)) && !defined(TAXEL_DISABLE_ASSERTS)
 #define TAXEL_ASSERTS_ACTIVE 1
-#define TAXEL_ASSERT(condition, message)                                           \
-  do {                                                                             \
-    if (!(condition)) {                                                            \
-      ::taxel::detail::assert_failed(#condition, message, __FILE__, __LINE__);     \
-    }                                                                              \
+#define TAXEL_ASSERT(condition, message)                                       \
+  do {                                                                         \
+    if (!(condition)) {                                                        \
+      ::taxel::detail::assert_failed(#condition, message, __FILE__, __LINE__); \
+    }                                                                          \
   } while (false)
 #else
 #define TAXEL_ASSERTS_ACTIVE 0

@@ -67,24 +67,31 @@ Mat3<S> pad_covariance(const Vec3<S>& normal, S sigma_normal, S sigma_tangent) {
 /// Why a contact cannot be used; `ok` when it can.
 enum class ContactDefect {
   ok,
-  non_finite_position,     ///< position has NaN or Inf
-  non_finite_covariance,   ///< covariance has NaN or Inf
-  asymmetric_covariance,   ///< covariance differs from its transpose beyond rounding
-  indefinite_covariance,   ///< covariance is not positive definite
-  bad_normal,              ///< normal is present but not finite or not of unit length (1e-3)
-  overflow,                ///< fusing it would overflow the model (extreme magnitudes)
+  non_finite_position,    ///< position has NaN or Inf
+  non_finite_covariance,  ///< covariance has NaN or Inf
+  asymmetric_covariance,  ///< covariance differs from its transpose beyond rounding
+  indefinite_covariance,  ///< covariance is not positive definite
+  bad_normal,             ///< normal is present but not finite or not of unit length (1e-3)
+  overflow,               ///< fusing it would overflow the model (extreme magnitudes)
 };
 
 /// Short description of a contact defect.
 constexpr std::string_view to_string(ContactDefect d) noexcept {
   switch (d) {
-    case ContactDefect::ok: return "ok";
-    case ContactDefect::non_finite_position: return "position is not finite";
-    case ContactDefect::non_finite_covariance: return "covariance is not finite";
-    case ContactDefect::asymmetric_covariance: return "covariance is not symmetric";
-    case ContactDefect::indefinite_covariance: return "covariance is not positive definite";
-    case ContactDefect::bad_normal: return "normal is not a finite unit vector";
-    case ContactDefect::overflow: return "fusing it would overflow";
+    case ContactDefect::ok:
+      return "ok";
+    case ContactDefect::non_finite_position:
+      return "position is not finite";
+    case ContactDefect::non_finite_covariance:
+      return "covariance is not finite";
+    case ContactDefect::asymmetric_covariance:
+      return "covariance is not symmetric";
+    case ContactDefect::indefinite_covariance:
+      return "covariance is not positive definite";
+    case ContactDefect::bad_normal:
+      return "normal is not a finite unit vector";
+    case ContactDefect::overflow:
+      return "fusing it would overflow";
   }
   return "unknown";
 }

@@ -58,7 +58,8 @@ class ProtocolError : public std::runtime_error {
  public:
   /// `device` names the device or transport; `packet_id` is the offending packet, if known.
   ProtocolError(std::string device, std::string reason, std::optional<int> packet_id = {})
-      : std::runtime_error(device + ": " + reason), device_(std::move(device)),
+      : std::runtime_error(device + ": " + reason),
+        device_(std::move(device)),
         packet_id_(packet_id) {}
 
   /// The device or transport name.

@@ -63,9 +63,9 @@ struct PointCloud {
     }
     for (const auto& f : fields) {
       if (f.values.size() != points.size()) {
-        return {Status::invalid_input, "field '" + f.name + "': " +
-                                           std::to_string(f.values.size()) + " values for " +
-                                           std::to_string(points.size()) + " points"};
+        return {Status::invalid_input,
+                "field '" + f.name + "': " + std::to_string(f.values.size()) + " values for " +
+                    std::to_string(points.size()) + " points"};
       }
     }
     for (std::size_t i = 0; i < points.size(); ++i) {

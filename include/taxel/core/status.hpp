@@ -10,19 +10,23 @@ namespace taxel {
 
 /// How an algorithm ended. Only `ok` means the result can be used without further checks.
 enum class Status {
-  ok,              ///< converged / succeeded
-  not_converged,   ///< stopped at an iteration limit; the result is the last iterate
-  degenerate,      ///< the input does not determine a unique answer (too few or collinear points)
-  invalid_input,   ///< non-finite values, mismatched sizes or out-of-range parameters
+  ok,             ///< converged / succeeded
+  not_converged,  ///< stopped at an iteration limit; the result is the last iterate
+  degenerate,     ///< the input does not determine a unique answer (too few or collinear points)
+  invalid_input,  ///< non-finite values, mismatched sizes or out-of-range parameters
 };
 
 /// Lower-case name of a status, as spelled in the enum.
 constexpr std::string_view to_string(Status s) noexcept {
   switch (s) {
-    case Status::ok: return "ok";
-    case Status::not_converged: return "not_converged";
-    case Status::degenerate: return "degenerate";
-    case Status::invalid_input: return "invalid_input";
+    case Status::ok:
+      return "ok";
+    case Status::not_converged:
+      return "not_converged";
+    case Status::degenerate:
+      return "degenerate";
+    case Status::invalid_input:
+      return "invalid_input";
   }
   return "unknown";
 }

@@ -48,8 +48,8 @@ struct Average {
   State init(const Contact<S>& c) const { return {c.position, c.covariance}; }
   /// Moves the mean towards the contact; always true (no gate).
   bool fuse(State& s, const Contact<S>& c, std::uint32_t n) const {
-    const S w = config_.mode == Mode::cumulative ? S(1) / (static_cast<S>(n) + S(1))
-                                                  : config_.alpha;
+    const S w =
+        config_.mode == Mode::cumulative ? S(1) / (static_cast<S>(n) + S(1)) : config_.alpha;
     s.mean += w * (c.position - s.mean);
     s.covariance = (S(1) - w) * (S(1) - w) * s.covariance + (w * w) * c.covariance;
     return true;

@@ -33,7 +33,7 @@ enum class InsertStatus : std::uint8_t {
 /// rejected, why.
 struct InsertResult {
   InsertStatus status = InsertStatus::rejected;
-  index::PointId id = 0;                    ///< the added or fused point; 0 when rejected
+  index::PointId id = 0;                     ///< the added or fused point; 0 when rejected
   ContactDefect defect = ContactDefect::ok;  ///< the reason for a rejection
 };
 
@@ -59,7 +59,7 @@ struct BatchResult {
 /// Not thread-safe for writes.
 template <FusionPolicy F = Kalman<double>,
           index::IncrementalIndex I = index::VoxelHash<typename F::Scalar>>
-  requires std::same_as<typename F::Scalar, typename I::Scalar>
+requires std::same_as<typename F::Scalar, typename I::Scalar>
 class ContactCloud {
  public:
   using Scalar = typename F::Scalar;
@@ -117,9 +117,15 @@ class ContactCloud {
     BatchResult r;
     for (const auto& c : contacts) {
       switch (insert(c).status) {
-        case InsertStatus::added: ++r.added; break;
-        case InsertStatus::fused: ++r.fused; break;
-        case InsertStatus::rejected: ++r.rejected; break;
+        case InsertStatus::added:
+          ++r.added;
+          break;
+        case InsertStatus::fused:
+          ++r.fused;
+          break;
+        case InsertStatus::rejected:
+          ++r.rejected;
+          break;
       }
     }
     return r;

@@ -34,9 +34,9 @@ struct Kalman {
   using Scalar = S;
   /// Configuration; defaults: no process noise, no gate, P0 = the first contact's R.
   struct Config {
-    S process_noise = S(0);           ///< q [m] per update, >= 0 (Q = q^2 I)
-    std::optional<S> gate_chi2{};     ///< Mahalanobis gate threshold (e.g. kChi2Dof3P99), > 0
-    std::optional<S> initial_sigma{}; ///< if set, P0 = sigma^2 I [m] instead of the contact's R
+    S process_noise = S(0);            ///< q [m] per update, >= 0 (Q = q^2 I)
+    std::optional<S> gate_chi2{};      ///< Mahalanobis gate threshold (e.g. kChi2Dof3P99), > 0
+    std::optional<S> initial_sigma{};  ///< if set, P0 = sigma^2 I [m] instead of the contact's R
   };
   /// A fused point: the filter's mean and covariance.
   struct State {
@@ -80,15 +80,14 @@ struct Kalman {
     }
     const Mat3<S> innovation_cov_inv = (p_pred + c.covariance).inverse();
     const Vec3<S> innovation = c.position - s.mean;
-    if (config_.gate_chi2 &&
-        innovation.dot(innovation_cov_inv * innovation) > *config_.gate_chi2) {
+    if (config_.gate_chi2 && innovation.dot(innovation_cov_inv * innovation) > *config_.gate_chi2) {
       return false;
     }
     const Mat3<S> gain = p_pred * innovation_cov_inv;
     s.mean += gain * innovation;
     const Mat3<S> i_minus_k = Mat3<S>::Identity() - gain;
-    const Mat3<S> joseph = i_minus_k * p_pred * i_minus_k.transpose() +
-                           gain * c.covariance * gain.transpose();
+    const Mat3<S> joseph =
+        i_minus_k * p_pred * i_minus_k.transpose() + gain * c.covariance * gain.transpose();
     s.covariance = S(0.5) * (joseph + joseph.transpose());
     return true;
   }

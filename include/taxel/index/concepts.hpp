@@ -63,15 +63,14 @@ concept SpatialIndex = requires(const I& index, const Vec3<typename I::Scalar>& 
 /// `move` and `erase` take a stored id (checked by TAXEL_ASSERT). After any sequence of
 /// operations the answers equal those of a freshly built index over the stored points.
 template <class I>
-concept IncrementalIndex =
-    SpatialIndex<I> && requires(I& index, PointId id, const Vec3<typename I::Scalar>& p,
-                                std::size_t n) {
-      index.insert(id, p);
-      index.move(id, p);
-      index.erase(id);
-      index.clear();
-      index.reserve(n);
-      { index.contains(id) } -> std::same_as<bool>;
-    };
+concept IncrementalIndex = SpatialIndex<I> &&
+    requires(I& index, PointId id, const Vec3<typename I::Scalar>& p, std::size_t n) {
+  index.insert(id, p);
+  index.move(id, p);
+  index.erase(id);
+  index.clear();
+  index.reserve(n);
+  { index.contains(id) } -> std::same_as<bool>;
+};
 
 }  // namespace taxel::index

@@ -426,8 +426,8 @@ class VoxelHash {
     }
     visit_cell(home, visit);
     for (int m = 1; m < 8; ++m) {
-      const S g2 = ((m & 1) ? gap2[0] : S(0)) + ((m & 2) ? gap2[1] : S(0)) +
-                   ((m & 4) ? gap2[2] : S(0));
+      const S g2 =
+          ((m & 1) ? gap2[0] : S(0)) + ((m & 2) ? gap2[1] : S(0)) + ((m & 4) ? gap2[2] : S(0));
       if (g2 > best.squared_distance) continue;
       visit_cell(Key{home.x + ((m & 1) ? step[0] : 0), home.y + ((m & 2) ? step[1] : 0),
                      home.z + ((m & 4) ? step[2] : 0)},

@@ -19,17 +19,17 @@ namespace taxel::sim {
 /// Parameters of a sliding exploration. Defaults: a 3x3 patch of a 3.4 mm-pitch pad in
 /// contact, sliding at 20 mm/s, 1 kHz frames.
 struct SlidingConfig {
-  double pitch = 3.4e-3;         ///< tactel pitch [m]
-  int rows = 3;                  ///< tactel rows of the patch in contact, >= 1
-  int cols = 3;                  ///< tactel columns of the patch in contact, >= 1
-  double speed = 0.02;           ///< sliding speed [m/s]
-  double frame_rate = 1000.0;    ///< frames per second [Hz]
-  double heading_sigma = 0.05;   ///< random-walk step of the sliding direction [rad/frame]
-  double sigma_normal = 1.0e-3;  ///< contact noise along the pad normal [m]
+  double pitch = 3.4e-3;           ///< tactel pitch [m]
+  int rows = 3;                    ///< tactel rows of the patch in contact, >= 1
+  int cols = 3;                    ///< tactel columns of the patch in contact, >= 1
+  double speed = 0.02;             ///< sliding speed [m/s]
+  double frame_rate = 1000.0;      ///< frames per second [Hz]
+  double heading_sigma = 0.05;     ///< random-walk step of the sliding direction [rad/frame]
+  double sigma_normal = 1.0e-3;    ///< contact noise along the pad normal [m]
   double sigma_position = 0.2e-3;  ///< kinematic translation noise per frame [m]
-  double sigma_tilt = 0.05;      ///< kinematic orientation noise per frame [rad]
-  double contact_depth = 1.5e-3; ///< a tactel touches when within this distance of the surface [m]
-  std::uint64_t seed = 1;        ///< random seed; equal seeds give equal streams
+  double sigma_tilt = 0.05;        ///< kinematic orientation noise per frame [rad]
+  double contact_depth = 1.5e-3;  ///< a tactel touches when within this distance of the surface [m]
+  std::uint64_t seed = 1;         ///< random seed; equal seeds give equal streams
 };
 
 /// `count` contacts of a pad sliding over `shape` (in the shape's frame). Each frame moves the
