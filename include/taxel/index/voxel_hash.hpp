@@ -149,19 +149,7 @@ class VoxelHash {
     const Key home = key_of(q);
     Neighbor<S> best{0, r * r};
     bool found = false;
-    auto visit = [&](const Block& b) {
-      S d2[kBlockCapacity];
-      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {  // fixed trip count: vectorises
-        d2[l] = squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q);
-      }
-      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
-        if (d2[l] < best.squared_distance ||
-            (d2[l] == best.squared_distance && (!found || b.ids[l] < best.id))) {
-          best = {b.ids[l], d2[l]};
-          found = true;
-        }
-      }
-    };
+    auto visit = [&](const Block& b) { consider(b, q, best, found); };
     if (volume(lo, hi) > static_cast<double>(cells_)) {
       for (const Block& b : blocks_) visit(b);
       return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
@@ -401,19 +389,7 @@ class VoxelHash {
   std::optional<Neighbor<S>> nearest_in_block(const Vec3<S>& q, const Vec3<S>& t, S r) const {
     Neighbor<S> best{0, r * r};
     bool found = false;
-    auto visit = [&](const Block& b) {
-      S d2[kBlockCapacity];
-      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
-        d2[l] = squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q);
-      }
-      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
-        if (d2[l] < best.squared_distance ||
-            (d2[l] == best.squared_distance && (!found || b.ids[l] < best.id))) {
-          best = {b.ids[l], d2[l]};
-          found = true;
-        }
-      }
-    };
+    auto visit = [&](const Block& b) { consider(b, q, best, found); };
     const Key home = key_of(q);
     std::int32_t step[3];
     S gap2[3];
@@ -434,6 +410,22 @@ class VoxelHash {
                  visit);
     }
     return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
+  }
+
+  // Updates (best, found) with the points of `b`: closer, or as close with a smaller id.
+  // All lanes are scanned (unused ones are at infinity): a fixed trip count vectorises.
+  static void consider(const Block& b, const Vec3<S>& q, Neighbor<S>& best, bool& found) {
+    S d2[kBlockCapacity];
+    for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
+      d2[l] = squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q);
+    }
+    for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
+      if (d2[l] < best.squared_distance ||
+          (d2[l] == best.squared_distance && (!found || b.ids[l] < best.id))) {
+        best = {b.ids[l], d2[l]};
+        found = true;
+      }
+    }
   }
 
   template <class Visit>
