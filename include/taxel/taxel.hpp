@@ -4,5 +4,6 @@
 
 #include "taxel/core.hpp"
 #include "taxel/fusion.hpp"
+#include "taxel/image.hpp"
 #include "taxel/index.hpp"
 #include "taxel/sim.hpp"

@@ -15,29 +15,9 @@
 namespace tf = taxel::fusion;
 namespace ti = taxel::index;
 
-// Counts heap allocations so a test can prove a code path allocates nothing. AddressSanitizer
-// owns operator new itself, so the count is off (and the check skipped) under it.
-#if defined(__SANITIZE_ADDRESS__)
-#define TAXEL_TEST_COUNTS_ALLOCATIONS 0
-namespace {
-std::atomic<long> g_allocations{0};
-}
-#else
-#define TAXEL_TEST_COUNTS_ALLOCATIONS 1
-namespace {
-std::atomic<long> g_allocations{0};
-}
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-#endif
+#include "support/allocation_counter.hpp"
+
+using taxel_test::g_allocations;
 
 namespace {
 

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+// Sobel gradients as MATLAB's imgradientxy / imgradient (REFERENCES.md section 2): correlation
+// with the Sobel kernels, replicate border; Gy > 0 when intensity grows downwards;
+// magnitude = hypot(Gx, Gy), direction = atan2(-Gy, Gx) in degrees. Also the contour pixels of a
+// region (MATLAB's bwperim, 4-connected).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "taxel/image/types.hpp"
+
+namespace taxel::image {
+
+/// Sobel derivatives of `img` into `gx` and `gy` (resized to the image's size).
+/// `gx = I (x) [-1 0 1; -2 0 2; -1 0 1]`, `gy = I (x) [-1 -2 -1; 0 0 0; 1 2 1]`.
+inline void sobel(const ImageView& img, ImageD& gx, ImageD& gy) {
+  const Eigen::Index rows = img.rows();
+  const Eigen::Index cols = img.cols();
+  gx.resize(rows, cols);
+  gy.resize(rows, cols);
+  if (rows == 0 || cols == 0) return;
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const Eigen::Index ru = std::max<Eigen::Index>(r - 1, 0);
+    const Eigen::Index rd = std::min<Eigen::Index>(r + 1, rows - 1);
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      const Eigen::Index cl = std::max<Eigen::Index>(c - 1, 0);
+      const Eigen::Index cr = std::min<Eigen::Index>(c + 1, cols - 1);
+      const double a = img(ru, cl), b = img(ru, c), d = img(ru, cr);
+      const double e = img(r, cl), f = img(r, cr);
+      const double g = img(rd, cl), h = img(rd, c), k = img(rd, cr);
+      gx(r, c) = (d + 2 * f + k) - (a + 2 * e + g);
+      gy(r, c) = (g + 2 * h + k) - (a + 2 * b + d);
+    }
+  }
+}
+
+/// Gradient magnitude and direction (degrees in (-180, 180], counter-clockwise from +x with y
+/// up) of `img`, as MATLAB's `[Gmag, Gdir] = imgradient(I)`. `gx`, `gy` are scratch.
+inline void gradient(const ImageView& img, ImageD& magnitude, ImageD& direction, ImageD& gx,
+                     ImageD& gy) {
+  sobel(img, gx, gy);
+  magnitude.resize(img.rows(), img.cols());
+  direction.resize(img.rows(), img.cols());
+  for (Eigen::Index i = 0; i < gx.size(); ++i) {
+    const double x = gx.data()[i];
+    const double y = gy.data()[i];
+    magnitude.data()[i] = std::hypot(x, y);
+    direction.data()[i] = std::atan2(-y, x) * 180.0 / std::numbers::pi;
+  }
+}
+
+/// Allocating convenience: gradient magnitude and direction of `img`.
+inline void gradient(const ImageView& img, ImageD& magnitude, ImageD& direction) {
+  ImageD gx, gy;
+  gradient(img, magnitude, direction, gx, gy);
+}
+
+/// True when pixel (r, c) of `region` is a contour pixel: inside the region with at least one
+/// 4-neighbour outside it or outside the image (MATLAB's `bwperim(BW, 4)`).
+inline bool is_contour_pixel(const MaskView& region, Eigen::Index r, Eigen::Index c) noexcept {
+  if (region(r, c) == 0) return false;
+  if (r == 0 || c == 0 || r + 1 == region.rows() || c + 1 == region.cols()) return true;
+  return region(r - 1, c) == 0 || region(r + 1, c) == 0 || region(r, c - 1) == 0 ||
+         region(r, c + 1) == 0;
+}
+
+/// The contour pixels of `region` into `out` (resized).
+inline void contour(const MaskView& region, Mask& out) {
+  out.resize(region.rows(), region.cols());
+  for (Eigen::Index r = 0; r < region.rows(); ++r) {
+    for (Eigen::Index c = 0; c < region.cols(); ++c) {
+      out(r, c) = is_contour_pixel(region, r, c) ? 1 : 0;
+    }
+  }
+}
+
+}  // namespace taxel::image

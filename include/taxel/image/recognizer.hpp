@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: MIT
+// The whole per-image chain of the second paper in one workspace: segmentation, HPR
+// descriptors, contour gradients, the edged/edgeless decision, RecEdged or RecEdgeless, the
+// hybrid feature vector and, optionally, a classifier's decision. No allocation after
+// construction for images of the constructed size.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <concepts>
+#include <stdexcept>
+#include <string>
+
+#include "taxel/core/status.hpp"
+#include "taxel/image/components.hpp"
+#include "taxel/image/features.hpp"
+#include "taxel/image/gradient.hpp"
+#include "taxel/image/reconstruction.hpp"
+#include "taxel/image/regionprops.hpp"
+#include "taxel/image/segmentation.hpp"
+
+namespace taxel::image {
+
+/// Decides edged (true) or edgeless (false) from the 23 edge features.
+template <class D>
+concept EdgeDecider = requires(const D& d, const Eigen::VectorXd& f) {
+  { d.edged(f) } -> std::convertible_to<bool>;
+};
+
+/// Classifies a hybrid feature vector into a class label.
+template <class C>
+concept FeatureClassifier = requires(const C& c, const Eigen::VectorXd& f) {
+  { c.predict(f) } -> std::convertible_to<int>;
+};
+
+/// The paper's rule: edged when the mean contour gradient magnitude of the largest HPR exceeds
+/// a threshold (`Gm > Gth`, Gth = 25 on a 0-255 scale).
+struct GradientThreshold {
+  double threshold = 25.0;  ///< Gth
+  [[nodiscard]] bool edged(const Eigen::VectorXd& f) const noexcept { return f(17) > threshold; }
+};
+
+/// The null classifier: no label (-1). Replace with a trained linear model.
+struct NoClassifier {
+  [[nodiscard]] int predict(const Eigen::VectorXd& /*features*/) const noexcept { return -1; }
+};
+
+/// Which image the contour gradients of the edge features are taken on.
+enum class GradientSource {
+  raw,        ///< the pressure image (default: "sudden vs gradual change" of pressure)
+  quantised,  ///< the k-means cluster image
+};
+
+/// Options of `Recognizer`.
+struct RecognizerConfig {
+  SegmentationConfig segmentation{};
+  GradientSource gradient_source = GradientSource::raw;
+  RecEdgedConfig edged{};
+  RecEdgelessConfig edgeless{};
+};
+
+/// Result of one image.
+struct Recognition : Outcome {
+  bool edged = false;             ///< the edged/edgeless decision
+  double contour_gradient = 0.0;  ///< Gm of the largest HPR (feature 18)
+  Eigen::VectorXd regional;       ///< 11 regional features
+  Eigen::VectorXd edge_features;  ///< 23 edged/edgeless features
+  Eigen::VectorXd hybrid;         ///< rows*cols gradient magnitudes (row-major) + 11
+  int label = -1;                 ///< the classifier's label (-1 without one)
+};
+
+/// Runs the second paper's chain on images of a fixed size.
+///
+/// Features 15-23 (PAPERS.md 2.6 #3): the paper lists three indices for each of "area",
+/// "average gradient magnitude" and "average gradient angle" of "the HPR having maximum area";
+/// taxel reads them as the three largest HPRs (8-connected, after small-region removal), in
+/// descending area, zero-padded when fewer exist. Gradient means are over each region's contour
+/// pixels (bwperim, 4-connected).
+template <EdgeDecider Decider = GradientThreshold, FeatureClassifier Classifier = NoClassifier>
+class Recognizer {
+ public:
+  explicit Recognizer(Eigen::Index rows = 32, Eigen::Index cols = 32, RecognizerConfig cfg = {},
+                      Decider decider = {}, Classifier classifier = {})
+      : rows_(rows),
+        cols_(cols),
+        cfg_(cfg),
+        decider_(std::move(decider)),
+        classifier_(std::move(classifier)),
+        segmenter_(cfg.segmentation, rows, cols),
+        analyzer_(RegionPropsOptions{.zero_based = false, .convex = true, .perimeter = false}, rows,
+                  cols),
+        components_(rows, cols),
+        reconstructor_(cfg.edged, cfg.edgeless, rows, cols) {
+    if (rows < 1 || cols < 1) {
+      throw std::invalid_argument("Recognizer: rows and cols must be >= 1");
+    }
+    result_.regional.setZero(kRegionalFeatures);
+    result_.edge_features.setZero(kEdgeFeatures);
+    result_.hybrid.setZero(rows * cols + kRegionalFeatures);
+    magnitude_.resize(rows, cols);
+    direction_.resize(rows, cols);
+    gx_.resize(rows, cols);
+    gy_.resize(rows, cols);
+    result_.message.reserve(64);
+  }
+
+  /// Runs the chain on `img`, which must be rows x cols. A wrong size or a non-finite pixel
+  /// gives `invalid_input` with all features zero.
+  const Recognition& recognize(const ImageView& img) {
+    Recognition& res = result_;
+    res.regional.setZero();
+    res.edge_features.setZero();
+    res.hybrid.setZero();
+    res.edged = false;
+    res.contour_gradient = 0.0;
+    res.label = -1;
+    res.status = Status::ok;
+    res.message.clear();
+    if (img.rows() != rows_ || img.cols() != cols_) {
+      res.status = Status::invalid_input;
+      res.message = "image size does not match the recognizer's";
+      return res;
+    }
+    const Segmentation& seg = segmenter_.run(img);
+    if (!seg.ok()) {
+      res.status = seg.status;
+      res.message = seg.message;
+      return res;
+    }
+
+    // Regional descriptors of the union of the HPRs.
+    const RegionProps& props = analyzer_.compute(seg.high);
+    regional_features(props, res.regional);
+    res.edge_features.head<kRegionalFeatures>() = res.regional;
+    res.edge_features(11) = img.maxCoeff();
+    res.edge_features(12) = img.minCoeff();
+    res.edge_features(13) = img.mean();
+
+    // The three largest HPRs and their contour gradients.
+    if (cfg_.gradient_source == GradientSource::raw) {
+      gradient(img, magnitude_, direction_, gx_, gy_);
+    } else {
+      gradient(seg.quantised, magnitude_, direction_, gx_, gy_);
+    }
+    const int n = components_.compute(seg.high, cfg_.segmentation.connectivity);
+    std::array<int, 3> top{0, 0, 0};
+    for (int id = 1; id <= n; ++id) {
+      for (int slot = 0; slot < 3; ++slot) {
+        if (top[slot] == 0 || components_.area(id) > components_.area(top[slot])) {
+          for (int s = 2; s > slot; --s) top[s] = top[s - 1];
+          top[slot] = id;
+          break;
+        }
+      }
+    }
+    std::array<double, 3> sum_mag{0, 0, 0}, sum_dir{0, 0, 0}, count{0, 0, 0};
+    const Labels& lab = components_.labels();
+    for (Eigen::Index r = 0; r < rows_; ++r) {
+      for (Eigen::Index c = 0; c < cols_; ++c) {
+        const int id = lab(r, c);
+        if (id == 0) continue;
+        int slot = -1;
+        for (int s = 0; s < 3; ++s) slot = top[s] == id ? s : slot;
+        if (slot < 0) continue;
+        const bool edge = r == 0 || c == 0 || r + 1 == rows_ || c + 1 == cols_ ||
+                          lab(r - 1, c) != id || lab(r + 1, c) != id || lab(r, c - 1) != id ||
+                          lab(r, c + 1) != id;
+        if (!edge) continue;
+        sum_mag[slot] += magnitude_(r, c);
+        sum_dir[slot] += direction_(r, c);
+        count[slot] += 1;
+      }
+    }
+    for (int s = 0; s < 3; ++s) {
+      if (top[s] == 0) continue;
+      res.edge_features(14 + s) = components_.area(top[s]);
+      res.edge_features(17 + s) = sum_mag[s] / count[s];
+      res.edge_features(20 + s) = sum_dir[s] / count[s];
+    }
+    res.contour_gradient = res.edge_features(17);
+    res.edged = decider_.edged(res.edge_features);
+
+    // Reconstruction and the hybrid vector.
+    const ImageD& height =
+        res.edged ? reconstructor_.rec_edged(seg) : reconstructor_.rec_edgeless(img, seg);
+    gradient(height, magnitude_, direction_, gx_, gy_);
+    res.hybrid.head(rows_ * cols_) = magnitude_.reshaped<Eigen::RowMajor>();
+    res.hybrid.tail<kRegionalFeatures>() = res.regional;
+    res.label = classifier_.predict(res.hybrid);
+    return res;
+  }
+
+  /// The last result.
+  [[nodiscard]] const Recognition& result() const noexcept { return result_; }
+  /// The last segmentation.
+  [[nodiscard]] const Segmentation& segmentation() const noexcept { return segmenter_.result(); }
+  /// The descriptors of the last image's HPRs.
+  [[nodiscard]] const RegionProps& region() const noexcept { return analyzer_.result(); }
+  /// The last reconstruction (height map).
+  [[nodiscard]] const ImageD& reconstruction() const noexcept { return reconstructor_.height(); }
+  /// The configuration.
+  [[nodiscard]] const RecognizerConfig& config() const noexcept { return cfg_; }
+
+ private:
+  Eigen::Index rows_, cols_;
+  RecognizerConfig cfg_;
+  Decider decider_;
+  Classifier classifier_;
+  Segmenter segmenter_;
+  RegionAnalyzer analyzer_;
+  Components components_;
+  Reconstructor reconstructor_;
+  ImageD magnitude_, direction_, gx_, gy_;
+  Recognition result_;
+};
+
+}  // namespace taxel::image

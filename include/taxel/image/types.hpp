@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: MIT
+// Image types of taxel::image: Eigen row-major arrays, views over them, and small enums.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string_view>
+
+namespace taxel::image {
+
+/// A 2-D image: `rows x cols`, row-major, indexed `(row, col)`, 0-based.
+template <class T>
+using Image = Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// Pressure image (any units; the second paper's images are 8-bit levels in [0, 255]).
+using ImageD = Image<double>;
+/// Binary mask: 0 = outside, anything else = inside.
+using Mask = Image<std::uint8_t>;
+/// Label image: 0 = background, 1..n = component number.
+using Labels = Image<std::int32_t>;
+
+/// Read-only view of a pressure image; accepts `ImageD`, blocks of it and `Eigen::Map`s.
+using ImageView = Eigen::Ref<const ImageD>;
+/// Read-only view of a mask.
+using MaskView = Eigen::Ref<const Mask>;
+
+/// Pixel adjacency for connected components.
+enum class Connectivity : int {
+  four = 4,   ///< edge neighbours only
+  eight = 8,  ///< edge and corner neighbours (MATLAB's default for 2-D)
+};
+
+/// Which end of the intensity scale means pressure. The second paper's text and its figure
+/// captions disagree (PAPERS.md 2.6 #1); taxel defaults to the physically meaningful reading.
+enum class Polarity {
+  high_is_pressure,  ///< larger values = more pressure (sensor counts, the figure captions)
+  dark_is_pressure,  ///< smaller values = more pressure (the text's "lowest centroid" wording)
+};
+
+/// Lower-case name of a polarity, as spelled in the enum.
+constexpr std::string_view to_string(Polarity p) noexcept {
+  return p == Polarity::high_is_pressure ? "high_is_pressure" : "dark_is_pressure";
+}
+
+}  // namespace taxel::image
