@@ -6,4 +6,5 @@
 #include "taxel/fusion.hpp"
 #include "taxel/image.hpp"
 #include "taxel/index.hpp"
+#include "taxel/io.hpp"
 #include "taxel/sim.hpp"

@@ -1,0 +1,7 @@
+// SPDX-License-Identifier: MIT
+// Umbrella header of taxel::io (without io/png.hpp, which needs libpng at link time).
+#pragma once
+
+#include "taxel/io/file.hpp"
+#include "taxel/io/image.hpp"
+#include "taxel/io/picture.hpp"

@@ -1,0 +1,454 @@
+// SPDX-License-Identifier: MIT
+// Pressure images from CSV, PGM (P2/P5, 8 or 16 bit) and NPY (2-D image or 3-D stack of frames,
+// little-endian integers and floats), read strictly: every error says where (line and column,
+// or byte offset) and what was expected. Writers for PGM and NPY; PNG is in io/png.hpp.
+//
+// CSV layout: one image row per line, values separated by commas (spaces and tabs around them
+// are allowed), every row the same length; blank lines and lines starting with '#' are skipped.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include "taxel/core/error.hpp"
+#include "taxel/image/types.hpp"
+#include "taxel/io/file.hpp"
+
+namespace taxel::io {
+
+/// Largest image the readers accept, in pixels over all frames (2^26 = 64 Mi values).
+inline constexpr std::uint64_t kMaxImageValues = std::uint64_t{1} << 26;
+
+/// One image or a stack of equally sized frames, row-major, frame after frame.
+struct ImageStack {
+  Eigen::Index frames = 0;     ///< number of frames (1 for a single image)
+  Eigen::Index rows = 0;       ///< rows of each frame
+  Eigen::Index cols = 0;       ///< columns of each frame
+  std::vector<double> values;  ///< frames * rows * cols values
+
+  /// A read-only view of frame `i` (0-based).
+  [[nodiscard]] Eigen::Map<const image::ImageD> frame(Eigen::Index i) const {
+    return {values.data() + i * rows * cols, rows, cols};
+  }
+};
+
+namespace detail {
+
+[[noreturn]] inline void fail_at_byte(const std::string& source, std::size_t offset,
+                                      const std::string& why) {
+  throw IoError(source, why, std::nullopt, offset);
+}
+
+inline void check_size(const std::string& source, std::uint64_t frames, std::uint64_t rows,
+                       std::uint64_t cols, std::size_t offset) {
+  if (rows == 0 || cols == 0 || frames == 0) fail_at_byte(source, offset, "image has no pixels");
+  if (rows > kMaxImageValues || cols > kMaxImageValues || frames > kMaxImageValues ||
+      rows * cols > kMaxImageValues / frames) {
+    fail_at_byte(source, offset,
+                 "image of " + std::to_string(frames) + " x " + std::to_string(rows) + " x " +
+                     std::to_string(cols) + " values exceeds the limit of " +
+                     std::to_string(kMaxImageValues));
+  }
+}
+
+}  // namespace detail
+
+/// Parses a CSV image. Throws IoError naming the line (and column) of the first error.
+inline ImageStack parse_image_csv(std::string_view text, const std::string& source = "<csv>") {
+  ImageStack out;
+  out.frames = 1;
+  std::uint64_t line_no = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string_view::npos || line[first] == '#') continue;
+    Eigen::Index cols = 0;
+    std::size_t i = 0;
+    while (true) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+      const std::size_t start = i;
+      while (i < line.size() && line[i] != ',' && line[i] != ' ' && line[i] != '\t') ++i;
+      const std::string_view field = line.substr(start, i - start);
+      const std::string where = "column " + std::to_string(cols + 1) + ": ";
+      if (field.empty()) throw IoError(source, where + "empty value", line_no);
+      double v = 0;
+      const char* b = field.data();
+      const char* e = b + field.size();
+      if (*b == '+') ++b;
+      const auto res = std::from_chars(b, e, v);
+      if (res.ec != std::errc() || res.ptr != e) {
+        throw IoError(source, where + "'" + std::string(field) + "' is not a number", line_no);
+      }
+      if (!std::isfinite(v)) {
+        throw IoError(source, where + "value is not finite", line_no);
+      }
+      if (out.values.size() >= kMaxImageValues) {
+        throw IoError(source, "more than " + std::to_string(kMaxImageValues) + " values", line_no);
+      }
+      out.values.push_back(v);
+      ++cols;
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+      if (i == line.size()) break;
+      if (line[i] != ',') {
+        throw IoError(source, where + "expected ',' between values", line_no);
+      }
+      ++i;
+    }
+    if (out.rows == 0) {
+      out.cols = cols;
+    } else if (cols != out.cols) {
+      throw IoError(source,
+                    "row has " + std::to_string(cols) + " values; the first row has " +
+                        std::to_string(out.cols),
+                    line_no);
+    }
+    ++out.rows;
+  }
+  if (out.rows == 0) throw IoError(source, "no image rows (empty file)");
+  return out;
+}
+
+/// Parses a PGM image (P2 ASCII or P5 binary, maxval 1..65535, 16-bit samples big-endian as
+/// Netpbm specifies). Several images of the same size, one after another, make a stack.
+/// Throws IoError with the byte offset of the first error.
+inline ImageStack parse_pgm(std::string_view bytes, const std::string& source = "<pgm>") {
+  ImageStack out;
+  std::size_t pos = 0;
+  auto skip_space = [&] {
+    while (pos < bytes.size()) {
+      const char ch = bytes[pos];
+      if (ch == '#') {
+        while (pos < bytes.size() && bytes[pos] != '\n') ++pos;
+      } else if (ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r' || ch == '\v' || ch == '\f') {
+        ++pos;
+      } else {
+        break;
+      }
+    }
+  };
+  auto number = [&](const char* what, std::uint64_t max) -> std::uint64_t {
+    skip_space();
+    const std::size_t start = pos;
+    std::uint64_t v = 0;
+    while (pos < bytes.size() && bytes[pos] >= '0' && bytes[pos] <= '9') {
+      v = v * 10 + static_cast<std::uint64_t>(bytes[pos] - '0');
+      if (v > max) {
+        detail::fail_at_byte(source, start, std::string(what) + " exceeds " + std::to_string(max));
+      }
+      ++pos;
+    }
+    if (pos == start) {
+      detail::fail_at_byte(source, start,
+                           pos < bytes.size() ? std::string("expected ") + what
+                                              : std::string("file ends before ") + what);
+    }
+    return v;
+  };
+  while (true) {
+    const std::size_t header = pos;
+    if (bytes.size() - pos < 2 || bytes[pos] != 'P' ||
+        (bytes[pos + 1] != '2' && bytes[pos + 1] != '5')) {
+      detail::fail_at_byte(source, pos, "not a PGM image: expected 'P2' or 'P5'");
+    }
+    const bool binary = bytes[pos + 1] == '5';
+    pos += 2;
+    const std::uint64_t cols = number("width", kMaxImageValues);
+    const std::uint64_t rows = number("height", kMaxImageValues);
+    const std::uint64_t maxval = number("maxval", 65535);
+    if (maxval == 0) detail::fail_at_byte(source, pos, "maxval must be in [1, 65535]");
+    const std::uint64_t frames = static_cast<std::uint64_t>(out.frames) + 1;
+    detail::check_size(source, frames, rows, cols, header);
+    if (out.frames > 0 && (static_cast<Eigen::Index>(rows) != out.rows ||
+                           static_cast<Eigen::Index>(cols) != out.cols)) {
+      detail::fail_at_byte(source, header, "frame size differs from the first image's");
+    }
+    out.rows = static_cast<Eigen::Index>(rows);
+    out.cols = static_cast<Eigen::Index>(cols);
+    const std::uint64_t n = rows * cols;
+    if (binary) {
+      if (pos >= bytes.size()) detail::fail_at_byte(source, pos, "file ends before the pixels");
+      const char sep = bytes[pos];
+      if (sep != ' ' && sep != '\t' && sep != '\n' && sep != '\r') {
+        detail::fail_at_byte(source, pos, "expected one whitespace byte after maxval");
+      }
+      ++pos;
+      const std::uint64_t width = maxval > 255 ? 2 : 1;
+      if ((bytes.size() - pos) / width < n) {
+        detail::fail_at_byte(source, bytes.size(),
+                             "truncated: " + std::to_string(n) + " pixels of " +
+                                 std::to_string(width) + " byte(s) need " +
+                                 std::to_string(n * width) + " bytes, " +
+                                 std::to_string(bytes.size() - pos) + " remain");
+      }
+      for (std::uint64_t i = 0; i < n; ++i) {
+        std::uint64_t v = static_cast<unsigned char>(bytes[pos]);
+        if (width == 2) v = (v << 8) | static_cast<unsigned char>(bytes[pos + 1]);
+        if (v > maxval) {
+          detail::fail_at_byte(
+              source, pos,
+              "pixel value " + std::to_string(v) + " exceeds maxval " + std::to_string(maxval));
+        }
+        out.values.push_back(static_cast<double>(v));
+        pos += width;
+      }
+    } else {
+      for (std::uint64_t i = 0; i < n; ++i) {
+        const std::size_t at = pos;
+        const std::uint64_t v = number("a pixel value", 65535);
+        if (v > maxval) {
+          detail::fail_at_byte(
+              source, at,
+              "pixel value " + std::to_string(v) + " exceeds maxval " + std::to_string(maxval));
+        }
+        out.values.push_back(static_cast<double>(v));
+      }
+    }
+    out.frames += 1;
+    skip_space();
+    if (pos >= bytes.size()) break;
+  }
+  return out;
+}
+
+/// Parses a NumPy .npy file (format versions 1.0, 2.0 and 3.0): a 2-D array (rows, cols) or a
+/// 3-D stack (frames, rows, cols) of little-endian or byte-wide integers ('u1', 'i1', 'u2',
+/// 'i2', 'u4', 'i4', 'u8', 'i8') or floats ('f4', 'f8'), C or Fortran order. Non-finite floats
+/// are refused. Throws IoError with the byte offset of the first error.
+inline ImageStack parse_npy(std::string_view bytes, const std::string& source = "<npy>") {
+  static constexpr char kMagic[] = "\x93NUMPY";
+  if (bytes.size() < 10 || bytes.substr(0, 6) != std::string_view(kMagic, 6)) {
+    detail::fail_at_byte(source, 0, "not an NPY file: the magic string \\x93NUMPY is missing");
+  }
+  const int major = static_cast<unsigned char>(bytes[6]);
+  if (major < 1 || major > 3) {
+    detail::fail_at_byte(source, 6, "unsupported NPY format version " + std::to_string(major));
+  }
+  std::size_t header_len = 0;
+  std::size_t pos = 0;
+  if (major == 1) {
+    header_len = static_cast<unsigned char>(bytes[8]) |
+                 (static_cast<std::size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+    pos = 10;
+  } else {
+    if (bytes.size() < 12) detail::fail_at_byte(source, 8, "truncated header length");
+    for (int i = 3; i >= 0; --i) {
+      header_len =
+          (header_len << 8) | static_cast<unsigned char>(bytes[8 + static_cast<std::size_t>(i)]);
+    }
+    pos = 12;
+  }
+  if (header_len > bytes.size() - pos) {
+    detail::fail_at_byte(source, pos,
+                         "truncated: header of " + std::to_string(header_len) +
+                             " bytes runs past the end of the file");
+  }
+  const std::string_view header = bytes.substr(pos, header_len);
+  const std::size_t data_start = pos + header_len;
+
+  // The header is a Python dict literal: {'descr': '<f8', 'fortran_order': False, 'shape': (..)}
+  auto value_of = [&](std::string_view key) -> std::pair<std::string_view, std::size_t> {
+    const std::string quoted = "'" + std::string(key) + "'";
+    const auto k = header.find(quoted);
+    if (k == std::string_view::npos) {
+      detail::fail_at_byte(source, pos, "header lacks the key " + quoted);
+    }
+    auto v = header.find(':', k + quoted.size());
+    if (v == std::string_view::npos) detail::fail_at_byte(source, pos + k, "expected ':'");
+    ++v;
+    while (v < header.size() && header[v] == ' ') ++v;
+    return {header.substr(v), pos + v};
+  };
+  const auto [descr_text, descr_at] = value_of("descr");
+  if (descr_text.size() < 5 || descr_text[0] != '\'') {
+    detail::fail_at_byte(source, descr_at, "descr must be a quoted type string such as '<f8'");
+  }
+  const std::string_view descr = descr_text.substr(1, descr_text.find('\'', 1) - 1);
+  if (descr.size() != 3) {
+    detail::fail_at_byte(source, descr_at, "unsupported dtype '" + std::string(descr) + "'");
+  }
+  const char order = descr[0];
+  const char kind = descr[1];
+  const int width = descr[2] - '0';
+  const bool known = (kind == 'u' || kind == 'i')
+                         ? (width == 1 || width == 2 || width == 4 || width == 8)
+                         : (kind == 'f' && (width == 4 || width == 8));
+  if (!known) {
+    detail::fail_at_byte(source, descr_at,
+                         "unsupported dtype '" + std::string(descr) +
+                             "': use u1, i1, u2, i2, u4, i4, u8, i8, f4 or f8");
+  }
+  if (order == '>' && width > 1) {
+    detail::fail_at_byte(source, descr_at,
+                         "big-endian dtype '" + std::string(descr) + "' is not supported");
+  }
+  if (order != '<' && order != '|' && order != '>') {
+    detail::fail_at_byte(source, descr_at, "bad byte-order mark in '" + std::string(descr) + "'");
+  }
+  const auto [fortran_text, fortran_at] = value_of("fortran_order");
+  bool fortran = false;
+  if (fortran_text.substr(0, 4) == "True") {
+    fortran = true;
+  } else if (fortran_text.substr(0, 5) != "False") {
+    detail::fail_at_byte(source, fortran_at, "fortran_order must be True or False");
+  }
+  const auto [shape_text, shape_at] = value_of("shape");
+  if (shape_text.empty() || shape_text[0] != '(') {
+    detail::fail_at_byte(source, shape_at, "shape must be a tuple");
+  }
+  std::vector<std::uint64_t> shape;
+  std::size_t i = 1;
+  while (true) {
+    while (i < shape_text.size() && (shape_text[i] == ' ' || shape_text[i] == ',')) ++i;
+    if (i < shape_text.size() && shape_text[i] == ')') break;
+    std::uint64_t v = 0;
+    const std::size_t start = i;
+    while (i < shape_text.size() && shape_text[i] >= '0' && shape_text[i] <= '9') {
+      v = v * 10 + static_cast<std::uint64_t>(shape_text[i] - '0');
+      if (v > kMaxImageValues) {
+        detail::fail_at_byte(source, shape_at + start, "dimension exceeds the size limit");
+      }
+      ++i;
+    }
+    if (i == start) detail::fail_at_byte(source, shape_at + i, "malformed shape tuple");
+    shape.push_back(v);
+    if (shape.size() > 3) break;
+  }
+  if (shape.size() != 2 && shape.size() != 3) {
+    detail::fail_at_byte(source, shape_at,
+                         "expected a 2-D image or a 3-D stack of frames, got " +
+                             std::to_string(shape.size()) + " dimension(s)");
+  }
+  ImageStack out;
+  const std::uint64_t frames = shape.size() == 3 ? shape[0] : 1;
+  const std::uint64_t rows = shape[shape.size() - 2];
+  const std::uint64_t cols = shape[shape.size() - 1];
+  detail::check_size(source, frames, rows, cols, shape_at);
+  const std::uint64_t n = frames * rows * cols;
+  const auto w = static_cast<std::uint64_t>(width);
+  if ((bytes.size() - data_start) / w < n) {
+    detail::fail_at_byte(source, bytes.size(),
+                         "truncated: shape needs " + std::to_string(n * w) + " data bytes, " +
+                             std::to_string(bytes.size() - data_start) + " remain");
+  }
+  if (bytes.size() - data_start != n * w) {
+    detail::fail_at_byte(
+        source, data_start + n * w,
+        std::to_string(bytes.size() - data_start - n * w) + " unexpected bytes after the data");
+  }
+  out.frames = static_cast<Eigen::Index>(frames);
+  out.rows = static_cast<Eigen::Index>(rows);
+  out.cols = static_cast<Eigen::Index>(cols);
+  out.values.resize(n);
+  const char* p = bytes.data() + data_start;
+  for (std::uint64_t k = 0; k < n; ++k, p += width) {
+    std::uint64_t raw = 0;
+    for (int b = width - 1; b >= 0; --b) raw = (raw << 8) | static_cast<unsigned char>(p[b]);
+    double v = 0;
+    if (kind == 'u') {
+      v = static_cast<double>(raw);
+    } else if (kind == 'i') {
+      const unsigned shift = 64u - 8u * static_cast<unsigned>(width);
+      v = static_cast<double>(static_cast<std::int64_t>(raw << shift) >> shift);
+    } else if (width == 4) {
+      v = static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(raw)));
+    } else {
+      v = std::bit_cast<double>(raw);
+    }
+    if (!std::isfinite(v)) {
+      detail::fail_at_byte(source, static_cast<std::size_t>(p - bytes.data()),
+                           "value " + std::to_string(k) + " is not finite");
+    }
+    // Fortran order stores the whole array column-major: element (f, r, c) is at
+    // f + frames * (r + rows * c).
+    std::uint64_t dst = k;
+    if (fortran) {
+      const std::uint64_t f = k % frames;
+      const std::uint64_t r = (k / frames) % rows;
+      const std::uint64_t c = k / (frames * rows);
+      dst = (f * rows + r) * cols + c;
+    }
+    out.values[dst] = v;
+  }
+  return out;
+}
+
+/// Reads an image or a stack from a file, choosing the format by extension (.csv, .pgm, .npy).
+inline ImageStack read_image(const std::string& path) {
+  const std::string ext = extension(path);
+  if (ext == ".csv" || ext == ".txt") return parse_image_csv(read_file(path), path);
+  if (ext == ".pgm") return parse_pgm(read_file(path), path);
+  if (ext == ".npy") return parse_npy(read_file(path), path);
+  throw IoError(path, "unknown image format '" + ext + "': expected .csv, .pgm or .npy");
+}
+
+/// Encodes an image as binary PGM (P5): values are mapped linearly from [lo, hi] to
+/// [0, maxval] (clamped, rounded); maxval 255 gives 8-bit, up to 65535 gives 16-bit samples.
+inline std::string encode_pgm(const image::ImageView& img, double lo = 0.0, double hi = 255.0,
+                              int maxval = 255) {
+  if (maxval < 1 || maxval > 65535) throw std::invalid_argument("encode_pgm: maxval in [1, 65535]");
+  if (!(hi > lo)) throw std::invalid_argument("encode_pgm: hi must exceed lo");
+  std::string out = "P5\n" + std::to_string(img.cols()) + " " + std::to_string(img.rows()) + "\n" +
+                    std::to_string(maxval) + "\n";
+  for (Eigen::Index r = 0; r < img.rows(); ++r) {
+    for (Eigen::Index c = 0; c < img.cols(); ++c) {
+      const double t = std::clamp((img(r, c) - lo) / (hi - lo), 0.0, 1.0);
+      const auto v = static_cast<unsigned>(std::lround(t * maxval));
+      if (maxval > 255) out.push_back(static_cast<char>(v >> 8));
+      out.push_back(static_cast<char>(v & 0xFF));
+    }
+  }
+  return out;
+}
+
+/// Encodes frames of doubles as NPY version 1.0, dtype '<f8', shape (rows, cols) for one frame
+/// or (frames, rows, cols).
+inline std::string encode_npy(const ImageStack& stack) {
+  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (";
+  if (stack.frames != 1) dict += std::to_string(stack.frames) + ", ";
+  dict += std::to_string(stack.rows) + ", " + std::to_string(stack.cols) + "), }";
+  // Pad with spaces so that the data start at a multiple of 64 bytes, ending in '\n'.
+  const std::size_t total = (10 + dict.size() + 1 + 63) / 64 * 64;
+  dict.append(total - 10 - dict.size() - 1, ' ');
+  dict.push_back('\n');
+  std::string out("\x93NUMPY\x01\x00", 8);
+  out.push_back(static_cast<char>(dict.size() & 0xFF));
+  out.push_back(static_cast<char>(dict.size() >> 8));
+  out += dict;
+  for (double v : stack.values) {
+    const auto bits = std::bit_cast<std::uint64_t>(v);
+    for (int b = 0; b < 8; ++b) out.push_back(static_cast<char>((bits >> (8 * b)) & 0xFF));
+  }
+  return out;
+}
+
+/// Encodes one image as CSV (full precision, one row per line).
+inline std::string encode_image_csv(const image::ImageView& img) {
+  std::string out;
+  char buf[32];
+  for (Eigen::Index r = 0; r < img.rows(); ++r) {
+    for (Eigen::Index c = 0; c < img.cols(); ++c) {
+      if (c > 0) out.push_back(',');
+      const auto res = std::to_chars(buf, buf + sizeof buf, img(r, c));
+      out.append(buf, res.ptr);
+    }
+    out.push_back('\n');
+  }
+  return out;
+}
+
+}  // namespace taxel::io

@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: MIT
+// Tests of taxel::io image readers and writers: round trips, foreign conventions, and malformed
+// inputs that must be refused with the place of the error.
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <taxel/io.hpp>
+
+#if defined(TAXEL_TEST_HAVE_PNG)
+#include <taxel/io/png.hpp>
+#endif
+
+namespace tio = taxel::io;
+namespace ti = taxel::image;
+using Catch::Matchers::Contains;
+
+namespace {
+std::string npy(const std::string& descr, const std::string& shape, const std::string& data,
+                bool fortran = false, int version = 1) {
+  std::string dict = "{'descr': '" + descr + "', 'fortran_order': " + (fortran ? "True" : "False") +
+                     ", 'shape': " + shape + ", }\n";
+  std::string out("\x93NUMPY", 6);
+  out.push_back(static_cast<char>(version));
+  out.push_back('\0');
+  if (version == 1) {
+    out.push_back(static_cast<char>(dict.size() & 0xFF));
+    out.push_back(static_cast<char>(dict.size() >> 8));
+  } else {
+    for (int b = 0; b < 4; ++b) out.push_back(static_cast<char>((dict.size() >> (8 * b)) & 0xFF));
+  }
+  return out + dict + data;
+}
+
+ti::ImageD ramp_image(Eigen::Index rows, Eigen::Index cols) {
+  ti::ImageD img(rows, cols);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (Eigen::Index c = 0; c < cols; ++c) img(r, c) = static_cast<double>((r * 7 + c * 3) % 256);
+  }
+  return img;
+}
+}  // namespace
+
+TEST_CASE("CSV images: round trip and strict errors", "[io]") {
+  const ti::ImageD img = ramp_image(4, 5) * 0.25 - 3.0;
+  const tio::ImageStack s = tio::parse_image_csv(tio::encode_image_csv(img));
+  REQUIRE(s.frames == 1);
+  REQUIRE(s.rows == 4);
+  REQUIRE(s.cols == 5);
+  CHECK((s.frame(0) == img).all());
+
+  const tio::ImageStack t = tio::parse_image_csv("# comment\r\n1, 2,3\r\n\r\n 4 ,5, 6 \n");
+  CHECK(t.rows == 2);
+  CHECK(t.frame(0)(1, 2) == 6);
+
+  CHECK_THROWS_WITH(tio::parse_image_csv("1,2,3\n4,5\n", "f.csv"),
+                    Contains("f.csv:2") && Contains("the first row has 3"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("1,2\n3,x\n", "f.csv"),
+                    Contains("f.csv:2") && Contains("column 2") && Contains("'x'"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("1,,2\n"), Contains("column 2: empty value"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("1,nan\n"), Contains("not finite"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("1,inf\n"), Contains("not finite"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("1 2\n"), Contains("expected ','"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("\n# only a comment\n", "e.csv"),
+                    Contains("e.csv") && Contains("empty"));
+  CHECK_THROWS_AS(tio::parse_image_csv(""), taxel::IoError);
+}
+
+TEST_CASE("PGM images: P2 and P5, 8 and 16 bit, stacks, strict errors", "[io]") {
+  const ti::ImageD img = ramp_image(6, 9);
+  const tio::ImageStack s8 = tio::parse_pgm(tio::encode_pgm(img));
+  REQUIRE(s8.rows == 6);
+  REQUIRE(s8.cols == 9);
+  CHECK((s8.frame(0) == img).all());
+
+  const tio::ImageStack s16 = tio::parse_pgm(tio::encode_pgm(img * 200.0, 0, 65535, 65535));
+  CHECK((s16.frame(0) == img * 200.0).all());
+
+  const tio::ImageStack a =
+      tio::parse_pgm("P2\n# made by hand\n3 2\n# comment\n15\n0 1 2\n13 14 15\n");
+  CHECK(a.rows == 2);
+  CHECK(a.frame(0)(1, 2) == 15);
+
+  const std::string two = tio::encode_pgm(img) + tio::encode_pgm(img * 0.5);
+  const tio::ImageStack st = tio::parse_pgm(two);
+  CHECK(st.frames == 2);
+  CHECK((st.frame(1) == (img * 0.5).round()).all());
+
+  std::string truncated = tio::encode_pgm(img);
+  truncated.resize(truncated.size() - 5);
+  CHECK_THROWS_WITH(tio::parse_pgm(truncated, "t.pgm"),
+                    Contains("t.pgm: byte") && Contains("truncated"));
+  CHECK_THROWS_WITH(tio::parse_pgm("P2\n2 1\n10\n3 11\n"), Contains("exceeds maxval 10"));
+  CHECK_THROWS_WITH(tio::parse_pgm("P6\n2 1\n255\nabcdef"), Contains("expected 'P2' or 'P5'"));
+  CHECK_THROWS_WITH(tio::parse_pgm("P5\n99999999 99999999\n255\n"), Contains("exceeds"));
+  CHECK_THROWS_WITH(tio::parse_pgm("P5\n0 3\n255\n"), Contains("no pixels"));
+  CHECK_THROWS_WITH(tio::parse_pgm("P2\n2 2\n255\n1 2 3"), Contains("file ends before"));
+  CHECK_THROWS_WITH(tio::parse_pgm("P5\n2 1\n70000\nab"), Contains("maxval exceeds 65535"));
+  CHECK_THROWS_WITH(tio::parse_pgm(tio::encode_pgm(img) + tio::encode_pgm(ramp_image(2, 2))),
+                    Contains("frame size differs"));
+}
+
+TEST_CASE("NPY images: dtypes, stacks, Fortran order, versions, strict errors", "[io]") {
+  const ti::ImageD img = ramp_image(3, 4) - 100.0;
+  tio::ImageStack one{1, 3, 4, {img.data(), img.data() + img.size()}};
+  const tio::ImageStack back = tio::parse_npy(tio::encode_npy(one));
+  CHECK(back.frames == 1);
+  CHECK((back.frame(0) == img).all());
+  tio::ImageStack three{3, 3, 4, {}};
+  for (int f = 0; f < 3; ++f) {
+    for (Eigen::Index i = 0; i < img.size(); ++i) three.values.push_back(img.data()[i] * f);
+  }
+  const tio::ImageStack back3 = tio::parse_npy(tio::encode_npy(three));
+  CHECK(back3.frames == 3);
+  CHECK(back3.values == three.values);
+
+  // u1 and i2 and f4, hand-made.
+  const tio::ImageStack u1 =
+      tio::parse_npy(npy("|u1", "(2, 3)", std::string("\x00\x01\x02\xff\x10\x20", 6)));
+  CHECK(u1.frame(0)(1, 0) == 255);
+  const tio::ImageStack i2 =
+      tio::parse_npy(npy("<i2", "(1, 2)", std::string("\xfe\xff\x05\x01", 4)));
+  CHECK(i2.frame(0)(0, 0) == -2);
+  CHECK(i2.frame(0)(0, 1) == 261);
+  const float f[2] = {1.5f, -2.25f};
+  const tio::ImageStack f4 =
+      tio::parse_npy(npy("<f4", "(2, 1)", std::string(reinterpret_cast<const char*>(f), 8)));
+  CHECK(f4.frame(0)(1, 0) == -2.25);
+  // Fortran order: bytes column-major.
+  const tio::ImageStack fo =
+      tio::parse_npy(npy("|u1", "(2, 3)", std::string("\x01\x04\x02\x05\x03\x06", 6), true));
+  CHECK(fo.frame(0)(0, 1) == 2);
+  CHECK(fo.frame(0)(1, 0) == 4);
+  // Format version 2 header.
+  CHECK(tio::parse_npy(npy("|u1", "(1, 2)", std::string("\x07\x08", 2), false, 2)).frame(0)(0, 1) ==
+        8);
+
+  CHECK_THROWS_WITH(tio::parse_npy("NUMPY....", "x.npy"),
+                    Contains("x.npy: byte 0") && Contains("magic"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(2, 3)", "abc")), Contains("truncated"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(1, 2)", "abc")), Contains("1 unexpected bytes"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy(">f8", "(1, 1)", std::string(8, '\0'))),
+                    Contains("big-endian"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("<c16", "(1, 1)", std::string(16, '\0'))),
+                    Contains("unsupported dtype"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(1, 1, 1, 1)", "a")), Contains("dimension"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(4,)", "abcd")), Contains("1 dimension"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(0, 4)", "")), Contains("no pixels"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(99999999999, 4)", "")), Contains("limit"));
+  const double nan = std::nan("");
+  CHECK_THROWS_WITH(
+      tio::parse_npy(npy("<f8", "(1, 1)", std::string(reinterpret_cast<const char*>(&nan), 8))),
+      Contains("not finite"));
+  std::string cut = npy("|u1", "(1, 1)", "a");
+  cut.resize(20);
+  CHECK_THROWS_WITH(tio::parse_npy(cut), Contains("header of"));
+}
+
+TEST_CASE("image files by extension; pictures", "[io]") {
+  const auto dir = std::filesystem::temp_directory_path() / "taxel_io_test";
+  std::filesystem::create_directories(dir);
+  const ti::ImageD img = ramp_image(5, 7);
+  tio::write_file((dir / "a.PGM").string(), tio::encode_pgm(img));
+  tio::write_file((dir / "a.csv").string(), tio::encode_image_csv(img));
+  tio::ImageStack st{1, 5, 7, {img.data(), img.data() + img.size()}};
+  tio::write_file((dir / "a.npy").string(), tio::encode_npy(st));
+  for (const char* name : {"a.PGM", "a.csv", "a.npy"}) {
+    CHECK((tio::read_image((dir / name).string()).frame(0) == img).all());
+  }
+  CHECK_THROWS_WITH(tio::read_image((dir / "a.bmp").string()), Contains("unknown image format"));
+  CHECK_THROWS_WITH(tio::read_image((dir / "missing.csv").string()), Contains("cannot open"));
+
+  const tio::RgbImage pic = tio::colorize(img, 0, 255, 3);
+  CHECK(pic.rows == 15);
+  CHECK(pic.cols == 21);
+  const auto lo = tio::ramp(0.0), hi = tio::ramp(1.0);
+  CHECK(std::equal(lo.begin(), lo.end(), pic.at(0, 0)));
+  CHECK(hi[0] == 253);
+  const tio::RgbImage both = tio::side_by_side({pic, pic}, 4);
+  CHECK(both.cols == 46);
+  CHECK(tio::encode_ppm(both).substr(0, 2) == "P6");
+#if defined(TAXEL_TEST_HAVE_PNG)
+  tio::write_png((dir / "p.png").string(), both);
+  const tio::RgbImage again = tio::read_png((dir / "p.png").string());
+  CHECK(again.rows == both.rows);
+  CHECK(again.data == both.data);
+  CHECK_THROWS_AS(tio::read_png((dir / "a.csv").string()), taxel::IoError);
+#endif
+  std::filesystem::remove_all(dir);
+}
