@@ -3,6 +3,7 @@
 // bwareaopen).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -22,47 +23,68 @@ class Components {
   /// Preallocates for `rows x cols` images.
   void reserve(Eigen::Index rows, Eigen::Index cols) {
     labels_.resize(rows, cols);
-    stack_.reserve(static_cast<std::size_t>(rows * cols));
+    parent_.reserve(static_cast<std::size_t>(rows * cols) + 1);
+    remap_.reserve(static_cast<std::size_t>(rows * cols) + 1);
     area_.reserve(static_cast<std::size_t>(rows * cols) + 1);
   }
 
   /// Labels the non-zero pixels of `mask`; returns the number of components.
+  /// Two raster passes with union-find over provisional labels.
   int compute(const MaskView& mask, Connectivity connectivity = Connectivity::eight) {
     const Eigen::Index rows = mask.rows();
     const Eigen::Index cols = mask.cols();
     labels_.resize(rows, cols);
-    labels_.setZero();
+    parent_.clear();
+    parent_.push_back(0);
+    const bool eight = connectivity == Connectivity::eight;
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      const std::uint8_t* m = mask.data() + r * mask.outerStride();
+      std::int32_t* lab = labels_.data() + r * cols;
+      const std::int32_t* up = r > 0 ? lab - cols : nullptr;
+      for (Eigen::Index c = 0; c < cols; ++c) {
+        if (m[c] == 0) {
+          lab[c] = 0;
+          continue;
+        }
+        std::int32_t best = 0;
+        auto see = [&](std::int32_t l) {
+          if (l == 0) return;
+          l = find(l);
+          if (best == 0) {
+            best = l;
+          } else if (l != best) {
+            const std::int32_t lo = std::min(l, best), hi = std::max(l, best);
+            parent_[static_cast<std::size_t>(hi)] = lo;
+            best = lo;
+          }
+        };
+        if (c > 0) see(lab[c - 1]);
+        if (up != nullptr) {
+          see(up[c]);
+          if (eight && c > 0) see(up[c - 1]);
+          if (eight && c + 1 < cols) see(up[c + 1]);
+        }
+        if (best == 0) {
+          best = static_cast<std::int32_t>(parent_.size());
+          parent_.push_back(best);
+        }
+        lab[c] = best;
+      }
+    }
+    // Second pass: final ids in raster order of each component's first pixel, and areas.
+    remap_.assign(parent_.size(), 0);
     area_.assign(1, 0);
     count_ = 0;
-    const bool eight = connectivity == Connectivity::eight;
-    for (Eigen::Index r0 = 0; r0 < rows; ++r0) {
-      for (Eigen::Index c0 = 0; c0 < cols; ++c0) {
-        if (mask(r0, c0) == 0 || labels_(r0, c0) != 0) continue;
-        const std::int32_t id = ++count_;
-        std::int32_t area = 0;
-        stack_.clear();
-        stack_.push_back(static_cast<std::int32_t>(r0 * cols + c0));
-        labels_(r0, c0) = id;
-        while (!stack_.empty()) {
-          const std::int32_t p = stack_.back();
-          stack_.pop_back();
-          ++area;
-          const Eigen::Index r = p / cols;
-          const Eigen::Index c = p % cols;
-          for (Eigen::Index dr = -1; dr <= 1; ++dr) {
-            for (Eigen::Index dc = -1; dc <= 1; ++dc) {
-              if ((dr == 0 && dc == 0) || (!eight && dr != 0 && dc != 0)) continue;
-              const Eigen::Index rr = r + dr;
-              const Eigen::Index cc = c + dc;
-              if (rr < 0 || rr >= rows || cc < 0 || cc >= cols) continue;
-              if (mask(rr, cc) == 0 || labels_(rr, cc) != 0) continue;
-              labels_(rr, cc) = id;
-              stack_.push_back(static_cast<std::int32_t>(rr * cols + cc));
-            }
-          }
-        }
-        area_.push_back(area);
+    for (Eigen::Index i = 0; i < labels_.size(); ++i) {
+      std::int32_t& l = labels_.data()[i];
+      if (l == 0) continue;
+      const auto root = static_cast<std::size_t>(find(l));
+      if (remap_[root] == 0) {
+        remap_[root] = ++count_;
+        area_.push_back(0);
       }
+      l = remap_[root];
+      ++area_[static_cast<std::size_t>(l)];
     }
     return count_;
   }
@@ -77,8 +99,17 @@ class Components {
   }
 
  private:
+  std::int32_t find(std::int32_t l) noexcept {
+    while (parent_[static_cast<std::size_t>(l)] != l) {
+      const std::int32_t p = parent_[static_cast<std::size_t>(l)];
+      parent_[static_cast<std::size_t>(l)] = parent_[static_cast<std::size_t>(p)];
+      l = p;
+    }
+    return l;
+  }
+
   Labels labels_;
-  std::vector<std::int32_t> stack_;
+  std::vector<std::int32_t> parent_, remap_;
   std::vector<std::int32_t> area_;
   int count_ = 0;
 };

@@ -8,7 +8,9 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <concepts>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -90,7 +92,6 @@ class Recognizer {
         segmenter_(cfg.segmentation, rows, cols),
         analyzer_(RegionPropsOptions{.zero_based = false, .convex = true, .perimeter = false}, rows,
                   cols),
-        components_(rows, cols),
         reconstructor_(cfg.edged, cfg.edgeless, rows, cols) {
     if (rows < 1 || cols < 1) {
       throw std::invalid_argument("Recognizer: rows and cols must be >= 1");
@@ -99,9 +100,6 @@ class Recognizer {
     result_.edge_features.setZero(kEdgeFeatures);
     result_.hybrid.setZero(rows * cols + kRegionalFeatures);
     magnitude_.resize(rows, cols);
-    direction_.resize(rows, cols);
-    gx_.resize(rows, cols);
-    gy_.resize(rows, cols);
     result_.message.reserve(64);
   }
 
@@ -137,17 +135,16 @@ class Recognizer {
     res.edge_features(12) = img.minCoeff();
     res.edge_features(13) = img.mean();
 
-    // The three largest HPRs and their contour gradients.
-    if (cfg_.gradient_source == GradientSource::raw) {
-      gradient(img, magnitude_, direction_, gx_, gy_);
-    } else {
-      gradient(seg.quantised, magnitude_, direction_, gx_, gy_);
-    }
-    const int n = components_.compute(seg.high, cfg_.segmentation.connectivity);
+    // The three largest HPRs (components of the segmenter kept by the area rule) and the
+    // Sobel gradients on their contour pixels.
+    const Components& comps = segmenter_.components();
+    const int n = comps.count();
+    const int min_area = cfg_.segmentation.min_area;
     std::array<int, 3> top{0, 0, 0};
     for (int id = 1; id <= n; ++id) {
+      if (comps.area(id) < min_area) continue;
       for (int slot = 0; slot < 3; ++slot) {
-        if (top[slot] == 0 || components_.area(id) > components_.area(top[slot])) {
+        if (top[slot] == 0 || comps.area(id) > comps.area(top[slot])) {
           for (int s = 2; s > slot; --s) top[s] = top[s - 1];
           top[slot] = id;
           break;
@@ -155,26 +152,28 @@ class Recognizer {
       }
     }
     std::array<double, 3> sum_mag{0, 0, 0}, sum_dir{0, 0, 0}, count{0, 0, 0};
-    const Labels& lab = components_.labels();
-    for (Eigen::Index r = 0; r < rows_; ++r) {
+    const Labels& lab = comps.labels();
+    const ImageView source =
+        cfg_.gradient_source == GradientSource::raw ? img : ImageView(seg.quantised);
+    for (Eigen::Index r = 0; r < rows_ && top[0] != 0; ++r) {
       for (Eigen::Index c = 0; c < cols_; ++c) {
         const int id = lab(r, c);
         if (id == 0) continue;
-        int slot = -1;
-        for (int s = 0; s < 3; ++s) slot = top[s] == id ? s : slot;
+        const int slot = id == top[0] ? 0 : id == top[1] ? 1 : id == top[2] ? 2 : -1;
         if (slot < 0) continue;
         const bool edge = r == 0 || c == 0 || r + 1 == rows_ || c + 1 == cols_ ||
                           lab(r - 1, c) != id || lab(r + 1, c) != id || lab(r, c - 1) != id ||
                           lab(r, c + 1) != id;
         if (!edge) continue;
-        sum_mag[slot] += magnitude_(r, c);
-        sum_dir[slot] += direction_(r, c);
+        const auto [gx, gy] = sobel_at(source, r, c);
+        sum_mag[slot] += std::hypot(gx, gy);
+        sum_dir[slot] += std::atan2(-gy, gx) * (180.0 / std::numbers::pi);
         count[slot] += 1;
       }
     }
     for (int s = 0; s < 3; ++s) {
       if (top[s] == 0) continue;
-      res.edge_features(14 + s) = components_.area(top[s]);
+      res.edge_features(14 + s) = comps.area(top[s]);
       res.edge_features(17 + s) = sum_mag[s] / count[s];
       res.edge_features(20 + s) = sum_dir[s] / count[s];
     }
@@ -184,7 +183,7 @@ class Recognizer {
     // Reconstruction and the hybrid vector.
     const ImageD& height =
         res.edged ? reconstructor_.rec_edged(seg) : reconstructor_.rec_edgeless(img, seg);
-    gradient(height, magnitude_, direction_, gx_, gy_);
+    gradient_magnitude(height, magnitude_);
     res.hybrid.head(rows_ * cols_) = magnitude_.reshaped<Eigen::RowMajor>();
     res.hybrid.tail<kRegionalFeatures>() = res.regional;
     res.label = classifier_.predict(res.hybrid);
@@ -209,9 +208,8 @@ class Recognizer {
   Classifier classifier_;
   Segmenter segmenter_;
   RegionAnalyzer analyzer_;
-  Components components_;
   Reconstructor reconstructor_;
-  ImageD magnitude_, direction_, gx_, gy_;
+  ImageD magnitude_;
   Recognition result_;
 };
 

@@ -86,6 +86,8 @@ class Reconstructor {
     scratch_.resize(rows, cols);
     block_.resize(rows, cols);
     gap_.resize(rows, cols);
+    vander_.resize(rows, 7);
+    hat_.resize(7, rows);
     keep_rows_.reserve(static_cast<std::size_t>(rows));
     keep_cols_.reserve(static_cast<std::size_t>(cols));
   }
@@ -151,6 +153,12 @@ class Reconstructor {
     height_.resize(rows, cols);
     height_.setZero();
     if (!seg.ok() || rows == 0 || img.rows() != rows || img.cols() != cols) return height_;
+    if (block_.rows() != rows || block_.cols() != cols) {  // a new size: allocate once
+      block_.resize(rows, cols);
+      gap_.resize(rows, cols);
+      vander_.resize(rows, 7);
+      hat_.resize(7, rows);
+    }
     const double frac = edgeless_.background_fraction;
     keep_rows_.clear();
     keep_cols_.clear();
@@ -229,31 +237,36 @@ class Reconstructor {
 
   void fit_columns(Eigen::Index m1, Eigen::Index n1) {
     const int d = static_cast<int>(std::min<Eigen::Index>(edgeless_.degree, m1 - 1));
-    const auto x_of = [m1](Eigen::Index i) {
-      return m1 == 1 ? 0.0 : -1.0 + 2.0 * static_cast<double>(i) / static_cast<double>(m1 - 1);
-    };
+    // Vandermonde rows v_i = (1, x_i, ..., x_i^d) with x normalised to [-1, 1], kept in
+    // `vander_` (m1 x 7); the least-squares coefficients of a column y are G^-1 V' y with
+    // G = V'V, so the hat rows H = G^-1 V' (d+1 x m1) are computed once for all columns.
     using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 7, 7>;
-    using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 7, 1>;
     Small gram = Small::Zero(d + 1, d + 1);
-    double pw[7];
     for (Eigen::Index i = 0; i < m1; ++i) {
-      powers(x_of(i), d, pw);
+      const double x =
+          m1 == 1 ? 0.0 : -1.0 + 2.0 * static_cast<double>(i) / static_cast<double>(m1 - 1);
+      powers(x, d, &vander_(i, 0));
       for (int a = 0; a <= d; ++a) {
-        for (int b = 0; b <= d; ++b) gram(a, b) += pw[a] * pw[b];
+        for (int b = 0; b <= d; ++b) gram(a, b) += vander_(i, a) * vander_(i, b);
       }
     }
     const Eigen::LDLT<Small> ldlt(gram);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 7, 1> e(d + 1);
+    for (Eigen::Index i = 0; i < m1; ++i) {
+      for (int a = 0; a <= d; ++a) e(a) = vander_(i, a);
+      const auto h = ldlt.solve(e).eval();
+      for (int a = 0; a <= d; ++a) hat_(a, i) = h(a);
+    }
+    double coef[7];
     for (Eigen::Index j = 0; j < n1; ++j) {
-      SmallVec rhs = SmallVec::Zero(d + 1);
-      for (Eigen::Index i = 0; i < m1; ++i) {
-        powers(x_of(i), d, pw);
-        for (int a = 0; a <= d; ++a) rhs(a) += pw[a] * block_(i, j);
+      for (int a = 0; a <= d; ++a) {
+        double acc = 0;
+        for (Eigen::Index i = 0; i < m1; ++i) acc += hat_(a, i) * block_(i, j);
+        coef[a] = acc;
       }
-      const SmallVec coef = ldlt.solve(rhs);
       for (Eigen::Index i = 0; i < m1; ++i) {
-        powers(x_of(i), d, pw);
         double v = 0;
-        for (int a = 0; a <= d; ++a) v += coef(a) * pw[a];
+        for (int a = 0; a <= d; ++a) v += coef[a] * vander_(i, a);
         block_(i, j) = v;
       }
     }
@@ -295,6 +308,8 @@ class Reconstructor {
   RecEdgedConfig edged_;
   RecEdgelessConfig edgeless_;
   ImageD height_, scratch_, block_;
+  Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> vander_;
+  Eigen::Matrix<double, 7, Eigen::Dynamic> hat_;
   Image<std::uint8_t> gap_;
   std::vector<Eigen::Index> keep_rows_, keep_cols_;
 };

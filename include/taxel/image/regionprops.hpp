@@ -167,18 +167,22 @@ class RegionAnalyzer {
   // Euler numbers from Gray's bit-quad counts over the zero-padded bounding box.
   void euler(const MaskView& mask, Eigen::Index rmin, Eigen::Index rmax, Eigen::Index cmin,
              Eigen::Index cmax) {
-    auto at = [&](Eigen::Index r, Eigen::Index c) -> int {
-      if (r < rmin || r > rmax || c < cmin || c > cmax) return 0;
-      return mask(r, c) != 0 ? 1 : 0;
-    };
     int q1 = 0, q3 = 0, qd = 0;
+    const Eigen::Index stride = mask.outerStride();
     for (Eigen::Index r = rmin - 1; r <= rmax; ++r) {
+      const std::uint8_t* top = r >= rmin ? mask.data() + r * stride : nullptr;
+      const std::uint8_t* bot = r + 1 <= rmax ? mask.data() + (r + 1) * stride : nullptr;
+      int a = 0, d = 0;  // left column of the 2x2 window
       for (Eigen::Index c = cmin - 1; c <= cmax; ++c) {
-        const int a = at(r, c), b = at(r, c + 1), d = at(r + 1, c), e = at(r + 1, c + 1);
+        const bool in = c + 1 <= cmax;
+        const int b = in && top != nullptr && top[c + 1] != 0 ? 1 : 0;
+        const int e = in && bot != nullptr && bot[c + 1] != 0 ? 1 : 0;
         const int s = a + b + d + e;
-        if (s == 1) ++q1;
-        if (s == 3) ++q3;
-        if (s == 2 && a == e) ++qd;
+        q1 += s == 1 ? 1 : 0;
+        q3 += s == 3 ? 1 : 0;
+        qd += s == 2 && a == e ? 1 : 0;
+        a = b;
+        d = e;
       }
     }
     props_.euler_number = (q1 - q3 - 2 * qd) / 4;
@@ -196,6 +200,10 @@ class RegionAnalyzer {
   static std::int64_t round_half(std::int64_t n) noexcept {
     if (n % 2 == 0) return n / 2;
     return n > 0 ? (n + 1) / 2 : (n - 1) / 2;
+  }
+  // MATLAB round of a double: half away from zero.
+  static std::int64_t round_away(double v) noexcept {
+    return v >= 0 ? static_cast<std::int64_t>(v + 0.5) : -static_cast<std::int64_t>(-v + 0.5);
   }
   static std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
     std::int64_t q = a / b;
@@ -223,7 +231,7 @@ class RegionAnalyzer {
       const double m = static_cast<double>(y2 - y1) / static_cast<double>(x2 - x1);
       for (std::int64_t x = x1; x <= x2; ++x) {
         const double y = static_cast<double>(y1) + m * static_cast<double>(x - x1);
-        line_.push_back({x, static_cast<std::int64_t>(std::round(y))});
+        line_.push_back({x, round_away(y)});
       }
     } else {
       if (y1 > y2) {
@@ -234,7 +242,7 @@ class RegionAnalyzer {
       const double m = static_cast<double>(x2 - x1) / static_cast<double>(y2 - y1);
       for (std::int64_t y = y1; y <= y2; ++y) {
         const double x = static_cast<double>(x1) + m * static_cast<double>(y - y1);
-        line_.push_back({static_cast<std::int64_t>(std::round(x)), y});
+        line_.push_back({round_away(x), y});
       }
     }
     if (flip) std::reverse(line_.begin() + static_cast<std::ptrdiff_t>(start), line_.end());
@@ -254,13 +262,15 @@ class RegionAnalyzer {
       }
       if (first < 0) continue;
       const std::int64_t y = 2 * (r - rmin + 1);
-      for (const Eigen::Index c : {first, last}) {
-        const std::int64_t x = 2 * (c - cmin + 1);
-        points_.push_back({x, y - 1});
-        points_.push_back({x + 1, y});
-        points_.push_back({x, y + 1});
-        points_.push_back({x - 1, y});
-      }
+      // The other midpoints of the row lie on segments between these six.
+      const std::int64_t xf = 2 * (first - cmin + 1);
+      const std::int64_t xl = 2 * (last - cmin + 1);
+      points_.push_back({xf - 1, y});
+      points_.push_back({xf, y - 1});
+      points_.push_back({xf, y + 1});
+      points_.push_back({xl, y - 1});
+      points_.push_back({xl, y + 1});
+      points_.push_back({xl + 1, y});
     }
     // Andrew's monotone chain; collinear points dropped.
     std::sort(points_.begin(), points_.end(),

@@ -72,6 +72,7 @@ class Segmenter {
     values_.reserve(static_cast<std::size_t>(rows * cols));
     histogram_.reserve(std::min<std::size_t>(static_cast<std::size_t>(cfg.histogram_levels),
                                              static_cast<std::size_t>(rows * cols) * 4 + 256));
+    level_class_.reserve(histogram_.capacity());
   }
 
   /// The configuration.
@@ -87,10 +88,6 @@ class Segmenter {
     seg_.quantised.resize(rows, cols);
     seg_.high.resize(rows, cols);
     seg_.high_raw.resize(rows, cols);
-    seg_.classes.setZero();
-    seg_.quantised.setZero();
-    seg_.high.setZero();
-    seg_.high_raw.setZero();
     seg_.regions = 0;
     seg_.classes_count = cfg_.k;
     seg_.background_level = 0.0;
@@ -112,7 +109,9 @@ class Segmenter {
         }
         lo = std::min(lo, v);
         hi = std::max(hi, v);
-        integral = integral && v == std::floor(v);
+        // Integer-valued? (a truncating conversion, cheaper than std::floor without SSE4.1)
+        integral = integral && v > -2147483648.0 && v < 2147483647.0 &&
+                   static_cast<double>(static_cast<std::int32_t>(v)) == v;
       }
     }
     integral = integral && hi - lo < static_cast<double>(cfg_.histogram_levels);
@@ -138,13 +137,33 @@ class Segmenter {
     const KMeans1dResult& km = kmeans_.result();
     // Map cluster ranks to classes: lowest -> 0, highest -> k-1, middle ones in between.
     const int top = cfg_.k - 1;
-    for (Eigen::Index r = 0; r < rows; ++r) {
-      for (Eigen::Index c = 0; c < cols; ++c) {
-        const int cl = km.cluster_of(sign * img(r, c));
-        const int cls = km.k == 1 ? 0 : (cl == km.k - 1 ? top : cl);
-        seg_.classes(r, c) = static_cast<std::uint8_t>(cls);
-        seg_.quantised(r, c) = sign * km.centroids[static_cast<std::size_t>(cl)];
-        seg_.high_raw(r, c) = static_cast<std::uint8_t>(cls == top ? 1 : 0);
+    auto class_of_cluster = [&](int cl) { return km.k == 1 ? 0 : (cl == km.k - 1 ? top : cl); };
+    if (integral) {
+      // One lookup per level instead of a search per pixel.
+      const std::size_t n = histogram_.size();
+      level_class_.resize(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        level_class_[i] =
+            static_cast<std::uint8_t>(km.cluster_of(sign * (lo + static_cast<double>(i))));
+      }
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        for (Eigen::Index c = 0; c < cols; ++c) {
+          const int cl = level_class_[static_cast<std::size_t>(img(r, c) - lo)];
+          const int cls = class_of_cluster(cl);
+          seg_.classes(r, c) = static_cast<std::uint8_t>(cls);
+          seg_.quantised(r, c) = sign * km.centroids[static_cast<std::size_t>(cl)];
+          seg_.high_raw(r, c) = static_cast<std::uint8_t>(cls == top ? 1 : 0);
+        }
+      }
+    } else {
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        for (Eigen::Index c = 0; c < cols; ++c) {
+          const int cl = km.cluster_of(sign * img(r, c));
+          const int cls = class_of_cluster(cl);
+          seg_.classes(r, c) = static_cast<std::uint8_t>(cls);
+          seg_.quantised(r, c) = sign * km.centroids[static_cast<std::size_t>(cl)];
+          seg_.high_raw(r, c) = static_cast<std::uint8_t>(cls == top ? 1 : 0);
+        }
       }
     }
     seg_.background_level = sign * km.centroids.front();
@@ -158,8 +177,16 @@ class Segmenter {
   /// The last segmentation.
   [[nodiscard]] const Segmentation& result() const noexcept { return seg_; }
 
+  /// The connected components of the last image's HPRs before small-region removal
+  /// (`high_raw`): the kept regions are those with area >= min_area.
+  [[nodiscard]] const Components& components() const noexcept { return components_; }
+
  private:
   const Segmentation& fail(std::string why) {
+    seg_.classes.setZero();
+    seg_.quantised.setZero();
+    seg_.high.setZero();
+    seg_.high_raw.setZero();
     seg_.status = Status::invalid_input;
     seg_.message = std::move(why);
     seg_.kmeans = KMeans1dResult{};
@@ -172,6 +199,7 @@ class Segmenter {
   Segmentation seg_;
   std::vector<double> values_;
   std::vector<std::uint32_t> histogram_;
+  std::vector<std::uint8_t> level_class_;
 };
 
 /// Allocating convenience: segments one image.
