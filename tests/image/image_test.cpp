@@ -494,6 +494,9 @@ TEST_CASE("segmentation: classes, polarity, small regions, degenerate images", "
   CHECK(b.status == taxel::Status::invalid_input);
   CHECK(b.message.find("(2, 3)") != std::string::npos);
   CHECK(ti::segment(ti::ImageD(0, 0)).status == taxel::Status::invalid_input);
+  ti::ImageD huge = img;
+  huge(0, 0) = 1e194;  // found by fuzz_image_readers: would overflow sums of squares
+  CHECK(ti::segment(huge).status == taxel::Status::invalid_input);
   CHECK_THROWS_AS(ti::Segmenter({.k = 1}), std::invalid_argument);
   CHECK_THROWS_AS(ti::Segmenter({.min_area = -1}), std::invalid_argument);
 }

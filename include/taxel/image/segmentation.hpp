@@ -78,7 +78,11 @@ class Segmenter {
   /// The configuration.
   [[nodiscard]] const SegmentationConfig& config() const noexcept { return cfg_; }
 
-  /// Segments `img`. A non-finite pixel or an empty image gives `invalid_input` with every
+  /// Largest pixel magnitude accepted: squares of gradients and sums of squares stay finite.
+  static constexpr double kMaxPixelMagnitude = 1e100;
+
+  /// Segments `img`. A non-finite pixel, one beyond +-kMaxPixelMagnitude, or an empty image
+  /// gives `invalid_input` with every
   /// output cleared to background. An image with one distinct value is all background (no
   /// HPR); with two, the upper value is high pressure and there is no low-pressure class.
   const Segmentation& run(const ImageView& img) {
@@ -104,8 +108,9 @@ class Segmenter {
     for (Eigen::Index r = 0; r < rows; ++r) {
       for (Eigen::Index c = 0; c < cols; ++c) {
         const double v = img(r, c);
-        if (!std::isfinite(v)) {
-          return fail("pixel (" + std::to_string(r) + ", " + std::to_string(c) + ") is not finite");
+        if (!std::isfinite(v) || std::abs(v) > kMaxPixelMagnitude) {
+          return fail("pixel (" + std::to_string(r) + ", " + std::to_string(c) + ") is " +
+                      (std::isfinite(v) ? "beyond +-1e100" : "not finite"));
         }
         lo = std::min(lo, v);
         hi = std::max(hi, v);
