@@ -262,7 +262,8 @@ inline ImageStack parse_npy(std::string_view bytes, const std::string& source = 
 
   // The header is a Python dict literal: {'descr': '<f8', 'fortran_order': False, 'shape': (..)}
   auto value_of = [&](std::string_view key) -> std::pair<std::string_view, std::size_t> {
-    const std::string quoted = "'" + std::string(key) + "'";
+    std::string quoted;  // append(): GCC 12 misreports -Wrestrict on "'" + std::string
+    quoted.append("'").append(key).append("'");
     const auto k = header.find(quoted);
     if (k == std::string_view::npos) {
       detail::fail_at_byte(source, pos, "header lacks the key " + quoted);
