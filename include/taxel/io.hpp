@@ -4,4 +4,5 @@
 
 #include "taxel/io/file.hpp"
 #include "taxel/io/image.hpp"
+#include "taxel/io/libsvm_format.hpp"
 #include "taxel/io/picture.hpp"

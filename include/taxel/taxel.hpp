@@ -7,4 +7,5 @@
 #include "taxel/image.hpp"
 #include "taxel/index.hpp"
 #include "taxel/io.hpp"
+#include "taxel/learn.hpp"
 #include "taxel/sim.hpp"
