@@ -148,7 +148,7 @@ TEST_CASE("LinearSvm model text round-trips exactly and is strict", "[learn]") {
   };
   const std::string head =
       "solver_type L2R_L2LOSS_SVC_DUAL\nnr_class 2\nlabel 1 -1\nnr_feature 2\nbias -1\nw\n";
-  bad(head + "0.5\n", "m.model:8: unexpected end of file");
+  bad(head + "0.5\n", "m.model:8: unexpected end of file; expected 2 weights, found 1");
   bad(head + "0.5\nx\n", "m.model:8: expected a weight");
   bad(head + "0.5\nnan\n", "a finite number");
   bad(head + "0.5\n1\n2\n", "unexpected text after the last weight");

@@ -30,6 +30,23 @@ struct LibsvmReadOptions {
 
 namespace detail {
 inline bool libsvm_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+// A token for an error message: at most 24 characters, non-printable bytes as \xNN.
+inline std::string libsvm_quote(std::string_view t) {
+  std::string q = "`";
+  for (std::size_t i = 0; i < t.size() && i < 24; ++i) {
+    const auto c = static_cast<unsigned char>(t[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      q.push_back(static_cast<char>(c));
+    } else {
+      constexpr char kHex[] = "0123456789abcdef";
+      q.append("\\x").push_back(kHex[c >> 4]);
+      q.push_back(kHex[c & 15]);
+    }
+  }
+  if (t.size() > 24) q.append("...");
+  q.push_back('`');
+  return q;
+}
 }  // namespace detail
 
 /// Parses libsvm text into a dense data set. Labels must be integers (`+1`, `-1`, `3`, `2.0`);
@@ -78,10 +95,11 @@ inline learn::Dataset parse_libsvm(std::string_view text, const std::string& sou
       double v = 0.0;
       const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
       if (r.ec != std::errc{} || r.ptr != t.data() + t.size() || !std::isfinite(v)) {
-        fail(col, "expected a numeric label, found `" + std::string(tok) + "`");
+        fail(col, "expected a numeric label, found " + detail::libsvm_quote(tok));
       }
       if (v != std::floor(v) || std::fabs(v) > 2147483647.0) {
-        fail(col, "label `" + std::string(tok) + "` is not an integer (class labels must be)");
+        fail(col,
+             "label " + detail::libsvm_quote(tok) + " is not an integer (class labels must be)");
       }
       labels.push_back(static_cast<int>(v));
     }
@@ -93,7 +111,7 @@ inline learn::Dataset parse_libsvm(std::string_view text, const std::string& sou
       if (tok.empty()) break;
       const std::size_t colon = tok.find(':');
       if (colon == std::string_view::npos) {
-        fail(col, "expected <index>:<value>, found `" + std::string(tok) + "`");
+        fail(col, "expected <index>:<value>, found " + detail::libsvm_quote(tok));
       }
       const std::string_view key = tok.substr(0, colon);
       const std::string_view val = tok.substr(colon + 1);
@@ -102,7 +120,7 @@ inline learn::Dataset parse_libsvm(std::string_view text, const std::string& sou
         int g = 0;
         const auto r = std::from_chars(val.data(), val.data() + val.size(), g);
         if (r.ec != std::errc{} || r.ptr != val.data() + val.size()) {
-          fail(col + colon + 1, "expected an integer qid, found `" + std::string(val) + "`");
+          fail(col + colon + 1, "expected an integer qid, found " + detail::libsvm_quote(val));
         }
         if (row > 0 && !any_qid) fail(col, "qid on some lines only");
         any_qid = true;
@@ -114,7 +132,7 @@ inline learn::Dataset parse_libsvm(std::string_view text, const std::string& sou
       long long index = 0;
       const auto ri = std::from_chars(key.data(), key.data() + key.size(), index);
       if (ri.ec != std::errc{} || ri.ptr != key.data() + key.size() || index < 1) {
-        fail(col, "expected a feature index >= 1, found `" + std::string(key) + "`");
+        fail(col, "expected a feature index >= 1, found " + detail::libsvm_quote(key));
       }
       if (index <= last) {
         fail(col, "feature index " + std::to_string(index) + " does not follow " +
@@ -127,8 +145,9 @@ inline learn::Dataset parse_libsvm(std::string_view text, const std::string& sou
       double v = 0.0;
       const auto rv = std::from_chars(val.data(), val.data() + val.size(), v);
       if (val.empty() || rv.ec != std::errc{} || rv.ptr != val.data() + val.size()) {
-        fail(col + colon + 1, "expected a number after `" + std::string(key) + ":`, found `" +
-                                  std::string(val) + "`");
+        fail(col + colon + 1, "expected a number after " +
+                                  detail::libsvm_quote(tok.substr(0, colon + 1)) + ", found " +
+                                  detail::libsvm_quote(val));
       }
       if (!std::isfinite(v)) {
         fail(col + colon + 1, "feature " + std::to_string(index) + " is not finite");

@@ -249,17 +249,28 @@ class LinearSvm {
     }
     const int nr_w = (nr_class == 2 && !m.multiclass_cs_) ? 1 : nr_class;
     const auto dims = static_cast<Eigen::Index>(nr_feature);
-    if (static_cast<double>(dims) * nr_w > 1e9) tok.fail("the model is too large");
+    // Read the weights before sizing anything, so that a header cannot make us allocate more
+    // than the text holds.
+    const Eigen::Index rows = dims + (m.bias_ >= 0.0 ? 1 : 0);
+    std::vector<double> values;
+    while (!tok.at_end()) {
+      if (static_cast<double>(values.size()) >= static_cast<double>(rows) * nr_w) {
+        tok.fail("unexpected text after the last weight");
+      }
+      values.push_back(tok.real("a weight"));
+    }
+    if (static_cast<double>(values.size()) < static_cast<double>(rows) * nr_w) {
+      tok.fail("unexpected end of file; expected " + std::to_string(rows * nr_w) +
+               " weights, found " + std::to_string(values.size()));
+    }
     m.w_.resize(nr_w, dims);
     m.wb_ = Eigen::VectorXd::Zero(nr_w);
-    const Eigen::Index rows = dims + (m.bias_ >= 0.0 ? 1 : 0);
     for (Eigen::Index j = 0; j < rows; ++j) {
       for (Eigen::Index k = 0; k < nr_w; ++k) {
-        const double v = tok.real("a weight");
+        const double v = values[static_cast<std::size_t>(j * nr_w + k)];
         (j < dims ? m.w_(k, j) : m.wb_(k)) = v;
       }
     }
-    if (!tok.at_end()) tok.fail("unexpected text after the last weight");
     return m;
   }
 

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: MIT
+// taxel-predict: applies a LIBLINEAR-format linear model to a libsvm-format data set and writes
+// one predicted label per line, with LIBLINEAR's `predict` output.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <string_view>
+#include <taxel/io.hpp>
+#include <taxel/learn.hpp>
+
+namespace {
+
+namespace tl = taxel::learn;
+
+constexpr const char* kUsage =
+    R"usage(Usage: taxel-predict [options] test_file model_file output_file
+options:
+-q : quiet mode (no outputs)
+-h, --help : show this help
+
+model_file is a LIBLINEAR text model (from taxel-train or LIBLINEAR's train, any classification
+solver). As LIBLINEAR does, features beyond the model's nr_feature are ignored. Prints
+"Accuracy = x% (correct/total)" against the labels of test_file.
+)usage";
+
+[[noreturn]] void fail(const std::string& why) {
+  std::fprintf(stderr, "taxel-predict: %s\n", why.c_str());
+  std::exit(1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    bool quiet = false;
+    std::vector<std::string> files;
+    for (int i = 1; i < argc; ++i) {
+      const std::string_view a = argv[i];
+      if (a == "-h" || a == "--help") {
+        std::fputs(kUsage, stdout);
+        return 0;
+      }
+      if (a == "-q") {
+        quiet = true;
+      } else if (a.size() > 1 && a[0] == '-') {
+        std::fprintf(stderr, "taxel-predict: unknown option %s\n%s", argv[i], kUsage);
+        return 1;
+      } else {
+        files.emplace_back(a);
+      }
+    }
+    if (files.size() != 3) {
+      std::fputs(kUsage, stderr);
+      return 1;
+    }
+    const tl::LinearSvm model = tl::LinearSvm::load(taxel::io::read_file(files[1]), files[1]);
+    tl::Dataset test = taxel::io::read_libsvm(files[0]);
+    if (test.dims() != model.dims()) {  // LIBLINEAR ignores extra features; absent ones are 0
+      tl::FeatureMatrix x = tl::FeatureMatrix::Zero(test.rows(), model.dims());
+      const Eigen::Index common = std::min(test.dims(), model.dims());
+      x.leftCols(common) = test.x.leftCols(common);
+      test.x = std::move(x);
+    }
+    std::string out;
+    std::size_t correct = 0;
+    for (Eigen::Index i = 0; i < test.rows(); ++i) {
+      const int label = model.predict(test.x.row(i).transpose());
+      correct += label == test.y[static_cast<std::size_t>(i)] ? 1 : 0;
+      out.append(std::to_string(label)).append("\n");
+    }
+    taxel::io::write_file(files[2], out);
+    if (!quiet) {
+      std::printf("Accuracy = %g%% (%zu/%zu)\n",
+                  100.0 * static_cast<double>(correct) / static_cast<double>(test.rows()), correct,
+                  static_cast<std::size_t>(test.rows()));
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+}

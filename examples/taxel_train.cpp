@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: MIT
+// taxel-train: trains a linear SVM on a libsvm-format data set, with LIBLINEAR's options,
+// output and model file, so it can stand in for LIBLINEAR's `train` (-s 1 and -s 3).
+#include <unistd.h>
+
+#include <charconv>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <string_view>
+#include <taxel/io.hpp>
+#include <taxel/learn.hpp>
+
+namespace {
+
+namespace tl = taxel::learn;
+
+constexpr const char* kUsage = R"usage(Usage: taxel-train [options] training_set_file [model_file]
+options:
+-s type : set type of solver (default 1)
+	 1 -- L2-regularized L2-loss support vector classification (dual)
+	 3 -- L2-regularized L1-loss support vector classification (dual)
+-c cost : set the parameter C (default 1)
+-e epsilon : set tolerance of termination criterion (default 0.1)
+	 |f'(alpha)|_max - |f'(alpha)|_min <= eps, the projected gradient spread
+-B bias : if bias >= 0, instance x becomes [x; bias]; if < 0, no bias term added (default -1)
+-v n: n-fold cross validation mode (stratified; prints Cross Validation Accuracy)
+-q : quiet mode (no outputs)
+--seed n : seed of the coordinate permutation and of the folds (default 1)
+--grouped : with -v, keep each qid group in one fold
+--max-iter n : outer iterations per binary problem (default 1000, as LIBLINEAR 2.3)
+-h, --help : show this help
+
+The model file is LIBLINEAR's text format (default: <training_set_file basename>.model in the
+current directory); LIBLINEAR's predict and taxel-predict both read it.
+)usage";
+
+[[noreturn]] void fail(const std::string& why) {
+  std::fprintf(stderr, "taxel-train: %s\n", why.c_str());
+  std::exit(1);
+}
+
+double number(std::string_view opt, const char* text) {
+  double v = 0.0;
+  const std::string_view t(text);
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (r.ec != std::errc{} || r.ptr != t.data() + t.size()) {
+    fail("option " + std::string(opt) + " expects a number, got '" + std::string(t) + "'");
+  }
+  return v;
+}
+
+std::string basename(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    tl::LinearSvmConfig cfg;
+    int folds = 0;
+    bool quiet = false;
+    bool grouped = false;
+    std::string data_file;
+    std::string model_file;
+    for (int i = 1; i < argc; ++i) {
+      const std::string_view a = argv[i];
+      const auto value = [&]() -> const char* {
+        if (i + 1 >= argc) fail("option " + std::string(a) + " needs a value");
+        return argv[++i];
+      };
+      if (a == "-h" || a == "--help") {
+        std::fputs(kUsage, stdout);
+        return 0;
+      } else if (a == "-s") {
+        const double s = number(a, value());
+        if (s != 1.0 && s != 3.0)
+          fail("-s " + std::to_string(static_cast<int>(s)) +
+               " is not supported: taxel-train has solvers 1 (L2-loss) and 3 (L1-loss)");
+        cfg.loss = s == 1.0 ? tl::SvmLoss::l2 : tl::SvmLoss::l1;
+      } else if (a == "-c") {
+        cfg.C = number(a, value());
+      } else if (a == "-e") {
+        cfg.eps = number(a, value());
+      } else if (a == "-B") {
+        cfg.bias = number(a, value());
+      } else if (a == "-v") {
+        const double v = number(a, value());
+        if (v < 2 || v != static_cast<int>(v))
+          fail("n-fold cross validation: n must be an integer >= 2");
+        folds = static_cast<int>(v);
+      } else if (a == "-q") {
+        quiet = true;
+      } else if (a == "--seed") {
+        cfg.seed = static_cast<std::uint64_t>(number(a, value()));
+      } else if (a == "--max-iter") {
+        cfg.max_iterations = static_cast<int>(number(a, value()));
+      } else if (a == "--grouped") {
+        grouped = true;
+      } else if (a.size() > 1 && a[0] == '-') {
+        std::fprintf(stderr, "taxel-train: unknown option %s\n%s", argv[i], kUsage);
+        return 1;
+      } else if (data_file.empty()) {
+        data_file = a;
+      } else if (model_file.empty()) {
+        model_file = a;
+      } else {
+        fail("too many arguments (see --help)");
+      }
+    }
+    if (data_file.empty()) {
+      std::fputs(kUsage, stderr);
+      return 1;
+    }
+    const tl::LinearSvm prototype(cfg);  // validates the options
+    const tl::Dataset data = taxel::io::read_libsvm(data_file);
+
+    if (folds > 0) {
+      tl::CvOptions opt;
+      opt.folds = folds;
+      opt.seed = cfg.seed;
+      opt.grouped = grouped;
+      if (!quiet && isatty(STDERR_FILENO) != 0) {
+        opt.progress = [](std::size_t done, std::size_t total) {
+          std::fprintf(stderr, "\rfold %zu/%zu%s", done, total, done == total ? "\n" : "");
+        };
+      }
+      const tl::CvReport r = tl::cross_validate(prototype, data.view(), opt);
+      if (r.status == taxel::Status::invalid_input || r.status == taxel::Status::degenerate) {
+        fail(data_file + ": " + r.message);
+      }
+      if (!r.ok() && !quiet) std::fprintf(stderr, "taxel-train: warning: %s\n", r.message.c_str());
+      std::printf("Cross Validation Accuracy = %g%%\n", 100.0 * r.accuracy);
+      return 0;
+    }
+
+    tl::LinearSvm model = prototype;
+    const taxel::Outcome o = model.fit(data.view());
+    if (o.status == taxel::Status::invalid_input || o.status == taxel::Status::degenerate) {
+      fail(data_file + ": " + o.message);
+    }
+    if (!quiet) {
+      const tl::LinearSvmTrainInfo& info = model.info();
+      for (std::size_t k = 0; k < info.iterations.size(); ++k) {
+        std::printf("optimization finished, #iter = %d\nObjective value = %f\nnSV = %d\n",
+                    info.iterations[k], info.objective[k], info.support_vectors[k]);
+      }
+      if (!o.ok()) std::fprintf(stderr, "taxel-train: warning: %s\n", o.message.c_str());
+    }
+    if (model_file.empty()) model_file = basename(data_file) + ".model";
+    taxel::io::write_file(model_file, model.save());
+    return 0;
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+}
