@@ -39,7 +39,7 @@ tl::Dataset draw(int n, int dims, unsigned seed, const tl::FeatureMatrix& means)
   return d;
 }
 
-const Problem& problem(int dims) {
+const Problem& data_for(int dims) {
   static std::map<int, Problem> cache;
   auto it = cache.find(dims);
   if (it != cache.end()) return it->second;
@@ -61,7 +61,7 @@ double accuracy(const auto& predict, const tl::Dataset& d) {
 }
 
 void BM_LinearSvmTrain(benchmark::State& state) {
-  const Problem& p = problem(static_cast<int>(state.range(0)));
+  const Problem& p = data_for(static_cast<int>(state.range(0)));
   tl::LinearSvm m;
   for (auto _ : state) {
     benchmark::DoNotOptimize(m.fit(p.train.view()));
@@ -75,7 +75,7 @@ void BM_LinearSvmTrain(benchmark::State& state) {
 BENCHMARK(BM_LinearSvmTrain)->Arg(11)->Arg(1035)->Unit(benchmark::kMillisecond);
 
 void BM_LinearSvmPredict(benchmark::State& state) {
-  const Problem& p = problem(static_cast<int>(state.range(0)));
+  const Problem& p = data_for(static_cast<int>(state.range(0)));
   tl::LinearSvm m;
   m.fit(p.train.view());
   Eigen::Index i = 0;
@@ -107,11 +107,11 @@ struct Sparse {
 };
 
 void BM_LiblinearTrain(benchmark::State& state) {
-  const Problem& p = problem(static_cast<int>(state.range(0)));
+  const Problem& p = data_for(static_cast<int>(state.range(0)));
   set_print_string_function([](const char*) {});
   Sparse s(p.train);
-  problem prob{static_cast<int>(p.train.rows()), static_cast<int>(p.train.dims()), s.y.data(),
-               s.ptr.data(), -1.0};
+  ::problem prob{static_cast<int>(p.train.rows()), static_cast<int>(p.train.dims()), s.y.data(),
+                 s.ptr.data(), -1.0};
   parameter par{};
   par.solver_type = L2R_L2LOSS_SVC_DUAL;
   par.C = 1.0;
@@ -133,11 +133,11 @@ void BM_LiblinearTrain(benchmark::State& state) {
 BENCHMARK(BM_LiblinearTrain)->Arg(11)->Arg(1035)->Unit(benchmark::kMillisecond);
 
 void BM_LiblinearPredict(benchmark::State& state) {
-  const Problem& p = problem(static_cast<int>(state.range(0)));
+  const Problem& p = data_for(static_cast<int>(state.range(0)));
   set_print_string_function([](const char*) {});
   Sparse s(p.train);
-  problem prob{static_cast<int>(p.train.rows()), static_cast<int>(p.train.dims()), s.y.data(),
-               s.ptr.data(), -1.0};
+  ::problem prob{static_cast<int>(p.train.rows()), static_cast<int>(p.train.dims()), s.y.data(),
+                 s.ptr.data(), -1.0};
   parameter par{};
   par.solver_type = L2R_L2LOSS_SVC_DUAL;
   par.C = 1.0;

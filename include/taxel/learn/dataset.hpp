@@ -121,13 +121,18 @@ inline Outcome validate_training_set(const DatasetView& d, const std::string& wh
 }
 
 namespace detail {
-/// Throws std::invalid_argument unless `x` has `dims` finite features.
-inline void check_sample(const SampleRef& x, Eigen::Index dims, const char* who) {
+/// Throws std::logic_error before training, std::invalid_argument unless `x` has `dims`
+/// features.
+inline void check_sample_size(const SampleRef& x, Eigen::Index dims, const char* who) {
   if (dims == 0) throw std::logic_error(std::string(who) + ": the model is not trained");
   if (x.size() != dims) {
     throw std::invalid_argument(std::string(who) + ": the sample has " + std::to_string(x.size()) +
                                 " features, the model was trained on " + std::to_string(dims));
   }
+}
+/// Throws like check_sample_size, and std::invalid_argument for a non-finite feature.
+inline void check_sample(const SampleRef& x, Eigen::Index dims, const char* who) {
+  check_sample_size(x, dims, who);
   if (!x.allFinite()) {
     throw std::invalid_argument(std::string(who) + ": the sample has a non-finite feature");
   }

@@ -124,7 +124,7 @@ class LinearSvm {
   /// Decision values, one per class in `classes()` order (for two classes: `f` and `-f`).
   /// Throws std::invalid_argument for a sample of the wrong length or non-finite features.
   void decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
-    detail::check_sample(x, dims(), "LinearSvm");
+    detail::check_sample_size(x, dims(), "LinearSvm");
     if (out.size() != static_cast<Eigen::Index>(classes_.size())) {
       throw std::invalid_argument("LinearSvm::decision: the output has " +
                                   std::to_string(out.size()) + " entries, the model has " +
@@ -135,21 +135,38 @@ class LinearSvm {
       out(0) = f;
       out(1) = -f;
     } else {
-      for (Eigen::Index k = 0; k < nr_w(); ++k) out(k) = raw_value(x, k);
+      out.noalias() = w_ * x;
+      if (bias_ >= 0.0) out += bias_ * wb_;
     }
+    if (!out.allFinite()) non_finite(x);
   }
 
   /// The predicted label. Throws like decision(). Allocates nothing.
   [[nodiscard]] int predict(const SampleRef& x) const {
-    detail::check_sample(x, dims(), "LinearSvm");
-    if (nr_w() == 1) return raw_value(x, 0) > 0.0 ? classes_[0] : classes_[1];
-    int best = 0;
-    double best_v = raw_value(x, 0);
-    for (Eigen::Index k = 1; k < nr_w(); ++k) {
-      const double v = raw_value(x, k);
-      if (v > best_v) {
-        best_v = v;
-        best = static_cast<int>(k);
+    detail::check_sample_size(x, dims(), "LinearSvm");
+    // A non-finite feature makes some decision value non-finite (0 * inf is NaN too), so the
+    // scores are checked instead of the sample.
+    if (nr_w() == 1) {
+      const double f = raw_value(x, 0);
+      if (!std::isfinite(f)) non_finite(x);
+      return f > 0.0 ? classes_[0] : classes_[1];
+    }
+    Eigen::Index best = 0;
+    if (nr_w() <= kStackClasses && dims() >= 32) {  // GEMV pays off beyond ~32 features
+      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kStackClasses, 1> v(nr_w());
+      v.noalias() = w_ * x;
+      if (bias_ >= 0.0) v += bias_ * wb_;
+      if (!v.allFinite()) non_finite(x);
+      v.maxCoeff(&best);
+    } else {
+      double best_v = -std::numeric_limits<double>::infinity();
+      for (Eigen::Index k = 0; k < nr_w(); ++k) {
+        const double v = raw_value(x, k);
+        if (!std::isfinite(v)) non_finite(x);
+        if (v > best_v) {
+          best_v = v;
+          best = k;
+        }
       }
     }
     return classes_[static_cast<std::size_t>(best)];
@@ -281,7 +298,15 @@ class LinearSvm {
     int support_vectors = 0;
   };
 
+  static constexpr int kStackClasses = 32;
+
   [[nodiscard]] Eigen::Index nr_w() const noexcept { return w_.rows(); }
+
+  [[noreturn]] static void non_finite(const SampleRef& x) {
+    if (!x.allFinite())
+      throw std::invalid_argument("LinearSvm: the sample has a non-finite feature");
+    throw std::invalid_argument("LinearSvm: a decision value overflowed (features too large)");
+  }
 
   [[nodiscard]] double raw_value(const SampleRef& x, Eigen::Index k) const noexcept {
     double v = w_.row(k).dot(x.transpose());
