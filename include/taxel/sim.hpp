@@ -3,4 +3,5 @@
 #pragma once
 
 #include "taxel/sim/shapes.hpp"
+#include "taxel/sim/palm_grasp.hpp"
 #include "taxel/sim/sliding.hpp"
