@@ -2,6 +2,6 @@
 // Umbrella header of taxel::sim.
 #pragma once
 
-#include "taxel/sim/shapes.hpp"
 #include "taxel/sim/palm_grasp.hpp"
+#include "taxel/sim/shapes.hpp"
 #include "taxel/sim/sliding.hpp"

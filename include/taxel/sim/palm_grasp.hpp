@@ -208,7 +208,7 @@ class PalmGraspSynth {
           const double e = edge_side ? w - obj_offset : obj_offset - w;
           const double ridge = std::exp(-0.5 * (e / sigma) * (e / sigma));
           const double face = e < 0 ? cfg_.plateau : cfg_.overhang;
-          return std::max(face, ridge) + (e < 0 ? 0.0 : 0.0);
+          return std::max(face, ridge);
         }
         case GraspClass::two_edged: {
           const double e = std::fabs(w - obj_offset) - half_width;
