@@ -1,26 +1,9 @@
 # SPDX-License-Identifier: MIT
 # Command-line contract of taxel-describe: --help, CSV and JSON output for an image and a stack,
 # and a one-line error with a non-zero exit on bad input.
-file(REMOVE_RECURSE "${WORK_DIR}")
-file(MAKE_DIRECTORY "${WORK_DIR}")
+include(${CMAKE_CURRENT_LIST_DIR}/cli_common.cmake)
 
-function(run expect_rc)
-  execute_process(COMMAND "${TOOL}" ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out
-                  ERROR_VARIABLE err)
-  if(NOT rc EQUAL expect_rc)
-    message(FATAL_ERROR "taxel-describe ${ARGN}: exit ${rc}, expected ${expect_rc}\n${out}\n${err}")
-  endif()
-  set(out "${out}" PARENT_SCOPE)
-  set(err "${err}" PARENT_SCOPE)
-endfunction()
-
-function(expect text pattern)
-  if(NOT text MATCHES "${pattern}")
-    message(FATAL_ERROR "expected /${pattern}/ in:\n${text}")
-  endif()
-endfunction()
-
-run(0 --help)
+run_tool("${TOOL}" 0 --help)
 expect("${out}" "usage: taxel-describe")
 
 # A 32x32 image with a sharp high-pressure band inside a low-pressure palm, as P2 PGM.
@@ -41,24 +24,24 @@ endforeach()
 file(WRITE "${WORK_DIR}/band.pgm" "${pgm}")
 file(WRITE "${WORK_DIR}/stack.pgm" "${pgm}${pgm}")
 
-run(0 "${WORK_DIR}/band.pgm")
+run_tool("${TOOL}" 0 "${WORK_DIR}/band.pgm")
 expect("${out}" "^file,frame,status,edged,Gm,Ar,xC,yC")
 expect("${out}" "band.pgm,0,ok,1,[0-9.]+,128,")
-run(0 --format json --hybrid "${WORK_DIR}/stack.pgm")
+run_tool("${TOOL}" 0 --format json --hybrid "${WORK_DIR}/stack.pgm")
 expect("${out}" "\"frame\": 1")
 expect("${out}" "\"edged\": true")
 expect("${out}" "\"hybrid\": \\[")
 
 file(WRITE "${WORK_DIR}/bad.csv" "1,2,3\n4,5\n")
-run(1 "${WORK_DIR}/bad.csv")
+run_tool("${TOOL}" 1 "${WORK_DIR}/bad.csv")
 expect("${err}" "^taxel-describe: .*bad.csv:2: row has 2 values")
-run(1 "${WORK_DIR}/missing.npy")
+run_tool("${TOOL}" 1 "${WORK_DIR}/missing.npy")
 expect("${err}" "cannot open")
-run(2 --k)
+run_tool("${TOOL}" 2 --k)
 expect("${err}" "--k needs a value")
-run(2 --k x "${WORK_DIR}/band.pgm")
+run_tool("${TOOL}" 2 --k x "${WORK_DIR}/band.pgm")
 expect("${err}" "not a valid number")
-run(1 --k 1 "${WORK_DIR}/band.pgm")
+run_tool("${TOOL}" 1 --k 1 "${WORK_DIR}/band.pgm")
 expect("${err}" "SegmentationConfig::k")
-run(2)
+run_tool("${TOOL}" 2)
 expect("${err}" "no input image")
