@@ -12,8 +12,11 @@
 //    width and gap jitter, grip force ~ U(force_min, force_max), a personal pressure pattern
 //    (palm heel vs finger pads). Per grasp: offset ~ N(0, offset_sd), rotation ~
 //    N(0, rotation_sd), force varies +-10 %; the left hand is the mirror image of the right.
+//    Soft tissue: the pressure of the palm and of each finger falls to 0 at the outline like a
+//    Hertzian contact, sqrt(d / rim) within `rim` tactels of the edge.
 //  - Object field p(w) over the signed distance w across the object's axis, which lies across
-//    the palm at a random angle (+- object_angle_deg) and offset:
+//    the palm, 0.45 palm lengths below the finger roots, at a random angle (+- object_angle_deg)
+//    and offset (+- object_offset):
 //      planar       p = 1 with a gentle random tilt (+-15 % over the hand);
 //      one-edged    the hand rests on a face ending at an edge: p = plateau on one side, an
 //                   edge ridge of height 1 and width sigma_e ~ U(edge_sigma) at the edge, falling
@@ -81,6 +84,7 @@ struct PalmGraspConfig {
   double finger_length = 13.0;
   double palm_length = 13.0;
   double scale_sd = 0.08;
+  double rim = 1.5;  ///< soft-tissue rim: pressure tapers to 0 over this many tactels
   // Placement.
   double offset_sd = 1.5;        ///< tactels
   double rotation_sd_deg = 7.0;  ///< hand rotation per grasp
@@ -91,7 +95,7 @@ struct PalmGraspConfig {
   // Objects.
   double plateau = 0.45;       ///< pressure on a face next to an edge, relative to the ridge
   double overhang = 0.08;      ///< pressure beyond an edge or a cylinder
-  Range edge_sigma{0.7, 1.8};  ///< width of an edge ridge
+  Range edge_sigma{1.3, 2.6};  ///< width of an edge ridge
   Range cuboid_width{7.0, 16.0};
   Range cylinder_radius{6.0, 15.0};
   // Sensor.
@@ -237,7 +241,7 @@ class PalmGraspSynth {
           const double hand = hand_pressure(s, a, b, span, palm_half);
           if (hand <= 0.0) continue;
           // Object coordinate: distance across the object's axis, which runs along "across".
-          const double w = -os * a + oc * b;
+          const double w = -os * a + oc * (b - 0.45 * cfg_.palm_length);
           acc += hand * object(w) * (1.0 + tilt_a * a + tilt_b * b);
         }
         double v = 0.0;
@@ -280,8 +284,11 @@ class PalmGraspSynth {
       // Rounded heel corners.
       const double corner = std::max(0.0, std::fabs(a) - (palm_half - 3.0));
       const double heel_edge = std::max(0.0, b - (cfg_.palm_length - 3.0));
-      if (corner * corner + heel_edge * heel_edge > 9.0) return 0.0;
-      return 0.9 + 0.15 * s.heel * (b / cfg_.palm_length);
+      const double rim = 3.0 - std::sqrt(corner * corner + heel_edge * heel_edge);
+      if (rim <= 0.0) return 0.0;
+      // Distance to the palm outline (the finger side joins the fingers and has no rim).
+      const double d = std::min({rim, palm_half - std::fabs(a), cfg_.palm_length - b});
+      return taper(d) * (0.9 + 0.15 * s.heel * (b / cfg_.palm_length));
     }
     // Fingers: strip index from the left edge of the span.
     const double x = a + 0.5 * span;
@@ -296,7 +303,15 @@ class PalmGraspSynth {
     // Creases between phalanges press less; the distal pad presses more.
     const double t = -b / len;
     const double crease = 1.0 - 0.35 * std::exp(-0.5 * std::pow((t - 0.5) / 0.05, 2));
-    return crease * (0.85 + 0.25 * s.pads * t);
+    const double d = std::min({in, s.finger_width - in, len + b});
+    return taper(d) * crease * (0.85 + 0.25 * s.pads * t);
+  }
+
+  // Soft tissue: contact pressure falls to zero at the outline of the contact patch like a
+  // Hertzian profile, sqrt(d / rim) within `rim` tactels of the edge.
+  double taper(double d) const noexcept {
+    if (cfg_.rim <= 0.0) return 1.0;
+    return d >= cfg_.rim ? 1.0 : std::sqrt(std::max(0.0, d) / cfg_.rim);
   }
 
   static std::uint64_t mix(std::uint64_t a, std::uint64_t b, std::uint64_t c, std::uint64_t d) {
