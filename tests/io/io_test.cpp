@@ -113,6 +113,18 @@ TEST_CASE("NPY images: dtypes, stacks, Fortran order, versions, strict errors", 
   const tio::ImageStack back3 = tio::parse_npy(tio::encode_npy(three));
   CHECK(back3.frames == 3);
   CHECK(back3.values == three.values);
+  // Integer dtypes round-trip exactly and refuse values they cannot hold.
+  tio::ImageStack bytes{2, 2, 2, {0, 1, 254, 255, 7, 8, 9, 10}};
+  const std::string u1_file = tio::encode_npy(bytes, tio::NpyDtype::u1);
+  CHECK(u1_file.find("'descr': '|u1'") != std::string::npos);
+  CHECK(u1_file.size() % 64 == 8 % 64);  // 64-byte aligned header + 8 one-byte values
+  CHECK(tio::parse_npy(u1_file).values == bytes.values);
+  bytes.values[3] = 60000;
+  CHECK(tio::parse_npy(tio::encode_npy(bytes, tio::NpyDtype::u2)).values == bytes.values);
+  CHECK_THROWS_WITH(tio::encode_npy(bytes, tio::NpyDtype::u1),
+                    Contains("at index 3 does not fit dtype |u1"));
+  bytes.values[5] = 0.5;
+  CHECK_THROWS_WITH(tio::encode_npy(bytes, tio::NpyDtype::u2), Contains("at index 5"));
 
   // u1 and i2 and f4, hand-made.
   const tio::ImageStack u1 =
@@ -187,4 +199,42 @@ TEST_CASE("image files by extension; pictures", "[io]") {
   CHECK_THROWS_AS(tio::read_png((dir / "a.csv").string()), taxel::IoError);
 #endif
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("SVG line plots: points, legend, escaping, reversed axis, errors", "[io][svg]") {
+  namespace tio = taxel::io;
+  const auto count = [](const std::string& s, const std::string& what) {
+    std::size_t n = 0;
+    for (auto p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+    return n;
+  };
+  tio::LinePlot plot;
+  plot.title = "accuracy <vs> SNR & noise";
+  plot.x_label = "SNR (dB)";
+  plot.y_label = "accuracy (%)";
+  plot.reverse_x = true;
+  plot.series.push_back({"conventional", {50, 40, 30}, {90, 80, 70}});
+  plot.series.push_back({"hybrid", {50, 40, 30}, {95, std::nan(""), 85}});
+  const std::string svg = tio::render_svg(plot);
+  CHECK(svg.rfind("<svg ", 0) == 0);
+  CHECK(svg.find("</svg>") != std::string::npos);
+  CHECK(count(svg, "<circle") == 5);  // the NaN point is left out
+  CHECK(count(svg, "<path") == 2);
+  CHECK(svg.find("accuracy &lt;vs&gt; SNR &amp; noise") != std::string::npos);
+  CHECK(svg.find(">hybrid</text>") != std::string::npos);
+  // Reversed x: the first point (x = 50) is drawn left of the last (x = 30).
+  const auto cx = [&](std::size_t nth) {
+    std::size_t p = 0;
+    for (std::size_t i = 0; i <= nth; ++i) p = svg.find("<circle cx=\"", p) + 12;
+    return std::stod(svg.substr(p));
+  };
+  CHECK(cx(0) < cx(2));
+  // The NaN breaks the hybrid line into two pieces.
+  CHECK(count(svg, " M") == 1);
+
+  tio::LinePlot bad;
+  bad.series.push_back({"broken", {1, 2}, {1}});
+  CHECK_THROWS_WITH(tio::render_svg(bad), Catch::Matchers::Contains("'broken' has 2 x values"));
+  tio::LinePlot empty;
+  CHECK(count(tio::render_svg(empty), "<circle") == 0);
 }

@@ -416,10 +416,29 @@ inline std::string encode_pgm(const image::ImageView& img, double lo = 0.0, doub
   return out;
 }
 
-/// Encodes frames of doubles as NPY version 1.0, dtype '<f8', shape (rows, cols) for one frame
-/// or (frames, rows, cols).
-inline std::string encode_npy(const ImageStack& stack) {
-  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (";
+/// Element type of an NPY file written by encode_npy.
+enum class NpyDtype {
+  f8,  ///< '<f8', any finite or non-finite double
+  u1,  ///< '|u1', integers 0..255 (8-bit sensor images; an eighth of the size)
+  u2,  ///< '<u2', integers 0..65535
+};
+
+/// Encodes frames as NPY version 1.0, shape (rows, cols) for one frame or (frames, rows, cols).
+/// For the integer types every value must be an integer in the type's range; otherwise throws
+/// std::invalid_argument naming the first offending value's index.
+inline std::string encode_npy(const ImageStack& stack, NpyDtype dtype = NpyDtype::f8) {
+  const char* descr = dtype == NpyDtype::f8 ? "<f8" : dtype == NpyDtype::u1 ? "|u1" : "<u2";
+  const double top = dtype == NpyDtype::u1 ? 255.0 : 65535.0;
+  if (dtype != NpyDtype::f8) {
+    for (std::size_t i = 0; i < stack.values.size(); ++i) {
+      const double v = stack.values[i];
+      if (!(v >= 0.0 && v <= top && v == std::floor(v))) {
+        throw std::invalid_argument("encode_npy: value " + std::to_string(v) + " at index " +
+                                    std::to_string(i) + " does not fit dtype " + descr);
+      }
+    }
+  }
+  std::string dict = std::string("{'descr': '") + descr + "', 'fortran_order': False, 'shape': (";
   if (stack.frames != 1) dict += std::to_string(stack.frames) + ", ";
   dict += std::to_string(stack.rows) + ", " + std::to_string(stack.cols) + "), }";
   // Pad with spaces so that the data start at a multiple of 64 bytes, ending in '\n'.
@@ -431,8 +450,16 @@ inline std::string encode_npy(const ImageStack& stack) {
   out.push_back(static_cast<char>(dict.size() >> 8));
   out += dict;
   for (double v : stack.values) {
-    const auto bits = std::bit_cast<std::uint64_t>(v);
-    for (int b = 0; b < 8; ++b) out.push_back(static_cast<char>((bits >> (8 * b)) & 0xFF));
+    if (dtype == NpyDtype::u1) {
+      out.push_back(static_cast<char>(static_cast<std::uint8_t>(v)));
+    } else if (dtype == NpyDtype::u2) {
+      const auto u = static_cast<std::uint16_t>(v);
+      out.push_back(static_cast<char>(u & 0xFF));
+      out.push_back(static_cast<char>(u >> 8));
+    } else {
+      const auto bits = std::bit_cast<std::uint64_t>(v);
+      for (int b = 0; b < 8; ++b) out.push_back(static_cast<char>((bits >> (8 * b)) & 0xFF));
+    }
   }
   return out;
 }
