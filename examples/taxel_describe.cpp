@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // taxel-describe: pressure images (CSV, PGM, NPY; stacks too) in, the second paper's
 // descriptors and features out, one line (CSV) or object (JSON) per frame.
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <exception>
@@ -8,6 +9,7 @@
 #include <string_view>
 #include <taxel/image.hpp>
 #include <taxel/io.hpp>
+#include <taxel/learn/dataset.hpp>
 #include <vector>
 
 namespace {
@@ -22,8 +24,14 @@ features, the edged decision and, with --hybrid, the 1035-long hybrid vector.
 IMAGE is a .csv (one row per line), .pgm (P2/P5, 8/16 bit; several frames allowed) or .npy
 (2-D image or 3-D stack of frames) file. One output record per frame.
 
+With --format libsvm the output is a training file for taxel-train (or LIBLINEAR): one line
+per frame, its label from --labels, then the 11 regional features (conventional recognition)
+or, with --hybrid, the 1035-long hybrid vector.
+
 options:
-  --format csv|json     output format (default csv)
+  --format csv|json|libsvm  output format (default csv)
+  --labels FILE         one integer label per frame, first token of each line ('#' comments
+                        and blank lines skipped); required by --format libsvm
   --hybrid              also print the hybrid feature vector (rows*cols + 11 values)
   --polarity high|dark  which end of the scale is pressure (default high)
   --k N                 k-means clusters (default 3)
@@ -36,6 +44,8 @@ options:
 
 struct Options {
   bool json = false;
+  bool libsvm = false;
+  std::string labels;
   bool hybrid = false;
   ti::RecognizerConfig cfg;
   double threshold = 25.0;
@@ -71,8 +81,11 @@ Options parse(int argc, char** argv) {
       std::exit(0);
     } else if (a == "--format") {
       const auto v = value();
-      if (v != "csv" && v != "json") die("--format must be csv or json");
+      if (v != "csv" && v != "json" && v != "libsvm") die("--format must be csv, json or libsvm");
       o.json = v == "json";
+      o.libsvm = v == "libsvm";
+    } else if (a == "--labels") {
+      o.labels = std::string(value());
     } else if (a == "--hybrid") {
       o.hybrid = true;
     } else if (a == "--polarity") {
@@ -97,6 +110,8 @@ Options parse(int argc, char** argv) {
     }
   }
   if (o.inputs.empty()) die("no input image (see --help)");
+  if (o.libsvm && o.labels.empty()) die("--format libsvm needs --labels FILE");
+  if (!o.libsvm && !o.labels.empty()) die("--labels is only used with --format libsvm");
   return o;
 }
 
@@ -122,6 +137,65 @@ std::string json_escape(std::string_view s) {
 constexpr const char* kExtra[] = {"MajorAxisLength", "MinorAxisLength", "Solidity", "Extent",
                                   "EquivDiameter",   "EulerNumber4",    "Perimeter"};
 
+// Labels: the first token of each non-blank, non-comment line, an integer.
+std::vector<int> read_labels(const std::string& path) {
+  const std::string text = taxel::io::read_file(path);
+  std::vector<int> labels;
+  std::size_t line_no = 0;
+  for (std::size_t pos = 0; pos < text.size();) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    std::string_view line(text.data() + pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string_view::npos || line[first] == '#') continue;
+    line.remove_prefix(first);
+    const auto stop = std::min(line.find_first_of(" \t\r,"), line.size());
+    const std::string_view token = line.substr(0, stop);
+    int v = 0;
+    const auto res = std::from_chars(token.data(), token.data() + token.size(), v);
+    if (res.ec != std::errc() || res.ptr != token.data() + token.size()) {
+      die(path + ":" + std::to_string(line_no) + ": '" + std::string(token.substr(0, 20)) +
+          "' is not an integer label");
+    }
+    labels.push_back(v);
+  }
+  return labels;
+}
+
+// --format libsvm: every frame's features with its label.
+int write_libsvm(const Options& opt, std::FILE* out) {
+  const std::vector<int> labels = read_labels(opt.labels);
+  taxel::learn::Dataset d;
+  std::vector<Eigen::VectorXd> rows;
+  for (const std::string& path : opt.inputs) {
+    const taxel::io::ImageStack stack = taxel::io::read_image(path);
+    ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg, ti::GradientThreshold{opt.threshold});
+    for (Eigen::Index f = 0; f < stack.frames; ++f) {
+      const ti::Recognition& r = rec.recognize(stack.frame(f));
+      if (!r.ok()) {
+        die(path + " frame " + std::to_string(f) + ": " + std::string(taxel::to_string(r.status)) +
+            ": " + r.message);
+      }
+      rows.push_back(opt.hybrid ? r.hybrid : r.regional);
+    }
+  }
+  if (labels.size() != rows.size()) {
+    die(opt.labels + " has " + std::to_string(labels.size()) + " labels for " +
+        std::to_string(rows.size()) + " frames");
+  }
+  d.x.resize(static_cast<Eigen::Index>(rows.size()), rows.empty() ? 0 : rows.front().size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].size() != d.x.cols()) die("the input images differ in size");
+    d.x.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  }
+  d.y = labels;
+  const std::string text = taxel::io::encode_libsvm(d.view());
+  std::fwrite(text.data(), 1, text.size(), out);
+  if (out != stdout && std::fclose(out) != 0) die("cannot write " + opt.output);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -131,6 +205,7 @@ int main(int argc, char** argv) try {
     out = std::fopen(opt.output.c_str(), "w");
     if (out == nullptr) die("cannot open " + opt.output + " for writing");
   }
+  if (opt.libsvm) return write_libsvm(opt, out);
   if (!opt.json) {
     std::string header = "file,frame,status,edged,Gm";
     for (const auto name : ti::kEdgeFeatureNames) header += "," + std::string(name);
