@@ -190,6 +190,12 @@ TEST_CASE("image files by extension; pictures", "[io]") {
   CHECK(hi[0] == 253);
   const tio::RgbImage both = tio::side_by_side({pic, pic}, 4);
   CHECK(both.cols == 46);
+  const tio::RgbImage tall = tio::stacked({pic, both}, 2);
+  CHECK(tall.rows == 15 + 2 + 15);
+  CHECK(tall.cols == 46);
+  CHECK(std::equal(pic.at(14, 0), pic.at(14, 0) + 21 * 3, tall.at(14, 0)));
+  CHECK(std::equal(both.at(0, 0), both.at(0, 0) + 46 * 3, tall.at(17, 0)));
+  CHECK(tall.at(16, 0)[0] == 255);  // the gap is white
   CHECK(tio::encode_ppm(both).substr(0, 2) == "P6");
 #if defined(TAXEL_TEST_HAVE_PNG)
   tio::write_png((dir / "p.png").string(), both);

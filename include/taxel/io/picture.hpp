@@ -100,6 +100,25 @@ inline RgbImage side_by_side(const std::vector<RgbImage>& panels, Eigen::Index g
   return out;
 }
 
+/// Places pictures one above the other with `gap` white pixels between them (left-aligned).
+inline RgbImage stacked(const std::vector<RgbImage>& panels, Eigen::Index gap = 8) {
+  Eigen::Index rows = 0, cols = 0;
+  for (const auto& p : panels) {
+    cols = std::max(cols, p.cols);
+    rows += p.rows;
+  }
+  if (!panels.empty()) rows += gap * static_cast<Eigen::Index>(panels.size() - 1);
+  RgbImage out(rows, cols);
+  Eigen::Index y0 = 0;
+  for (const auto& p : panels) {
+    for (Eigen::Index r = 0; r < p.rows; ++r) {
+      std::copy(p.at(r, 0), p.at(r, 0) + p.cols * 3, out.at(y0 + r, 0));
+    }
+    y0 += p.rows + gap;
+  }
+  return out;
+}
+
 /// Encodes a picture as binary PPM (P6), readable by every image viewer; no dependency.
 inline std::string encode_ppm(const RgbImage& img) {
   std::string out = "P6\n" + std::to_string(img.cols) + " " + std::to_string(img.rows) + "\n255\n";
