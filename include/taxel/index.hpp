@@ -6,4 +6,5 @@
 #include "taxel/index/concepts.hpp"
 #include "taxel/index/dynamic_kdtree.hpp"
 #include "taxel/index/kdtree.hpp"
+#include "taxel/index/uniform_grid.hpp"
 #include "taxel/index/voxel_hash.hpp"

@@ -3,5 +3,6 @@
 #pragma once
 
 #include "taxel/sim/palm_grasp.hpp"
+#include "taxel/sim/sampling.hpp"
 #include "taxel/sim/shapes.hpp"
 #include "taxel/sim/sliding.hpp"

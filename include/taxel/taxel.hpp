@@ -8,4 +8,5 @@
 #include "taxel/index.hpp"
 #include "taxel/io.hpp"
 #include "taxel/learn.hpp"
+#include "taxel/registration.hpp"
 #include "taxel/sim.hpp"

@@ -44,13 +44,15 @@ class NearestWithinSet {
  public:
   using DistanceType = S;
   using IndexType = std::uint32_t;
-  NearestWithinSet(S bound, const IdMap& ids) : best_{0, bound}, ids_(ids) {}
+  NearestWithinSet(S bound, const IdMap& ids) : best_{0, bound}, worst_(above(bound)), ids_(ids) {}
   bool full() const noexcept { return found_; }
-  S worstDist() const noexcept { return above(best_.squared_distance); }
+  // Cached: nanoflann asks for it at every node, and nextafter is a libm call.
+  S worstDist() const noexcept { return worst_; }
   bool addPoint(S d2, IndexType internal) {
     const Neighbor<S> n{ids_(internal), d2};
     if (n.squared_distance < best_.squared_distance ||
         (n.squared_distance == best_.squared_distance && (!found_ || n.id < best_.id))) {
+      if (n.squared_distance != best_.squared_distance) worst_ = above(n.squared_distance);
       best_ = n;
       found_ = true;
     }
@@ -62,6 +64,7 @@ class NearestWithinSet {
 
  private:
   Neighbor<S> best_;
+  S worst_;
   bool found_ = false;
   const IdMap& ids_;
 };
@@ -72,9 +75,9 @@ class WithinSet {
  public:
   using DistanceType = S;
   using IndexType = std::uint32_t;
-  WithinSet(S bound, const IdMap& ids) : bound_(bound), ids_(ids) {}
+  WithinSet(S bound, const IdMap& ids) : bound_(bound), worst_(above(bound)), ids_(ids) {}
   bool full() const noexcept { return true; }
-  S worstDist() const noexcept { return above(bound_); }
+  S worstDist() const noexcept { return worst_; }
   bool addPoint(S d2, IndexType internal) {
     if (d2 <= bound_) out.push_back({ids_(internal), d2});
     return true;
@@ -83,6 +86,7 @@ class WithinSet {
 
  private:
   S bound_;
+  S worst_;
   const IdMap& ids_;
 };
 
@@ -94,20 +98,20 @@ class KnnSet {
   using IndexType = std::uint32_t;
   KnnSet(std::size_t k, const IdMap& ids) : k_(k), ids_(ids) { out.reserve(k); }
   bool full() const noexcept { return out.size() == k_; }
-  S worstDist() const noexcept {
-    return full() ? above(out.back().squared_distance) : std::numeric_limits<S>::infinity();
-  }
+  S worstDist() const noexcept { return worst_; }
   bool addPoint(S d2, IndexType internal) {
     const Neighbor<S> n{ids_(internal), d2};
     if (full() && !closer(n, out.back())) return true;
     if (full()) out.pop_back();
     out.insert(std::upper_bound(out.begin(), out.end(), n, closer<S>), n);
+    if (full()) worst_ = above(out.back().squared_distance);
     return true;
   }
   std::vector<Neighbor<S>> out;
 
  private:
   std::size_t k_;
+  S worst_ = std::numeric_limits<S>::infinity();
   const IdMap& ids_;
 };
 

@@ -1,0 +1,278 @@
+// SPDX-License-Identifier: MIT
+// A static uniform grid over a fixed point set: a dense array of cell starts over the points'
+// bounding box and the points sorted by cell (CSR layout). Nearest-neighbour queries search
+// shells of cells outward from the query's cell and stop as soon as no unvisited cell can hold
+// a closer point, so answers are exact. Near the stored surface a query visits about 27 cells
+// in contiguous memory, a few times faster than a kd-tree; far from the box it falls back to
+// enumerating shells up to the query radius. Built for ICP targets (registration::Target).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "taxel/core/types.hpp"
+#include "taxel/index/concepts.hpp"
+
+namespace taxel::index {
+
+/// Static exact index on a uniform grid; point i has id i. Models SpatialIndex.
+/// Const queries may run concurrently.
+template <Scalar S>
+class UniformGrid {
+ public:
+  using Scalar = S;
+  /// Build parameters.
+  struct Config {
+    /// Cell edge [m]; 0 picks about twice the mean nearest-neighbour spacing of the points.
+    S cell = S(0);
+    /// Largest number of cells; the cell grows until the grid fits, >= 1.
+    std::size_t max_cells = std::size_t{1} << 24;
+  };
+
+  /// Builds the grid. Throws std::invalid_argument for non-finite points, a negative or
+  /// non-finite cell, or more than 2^32 - 1 points.
+  explicit UniformGrid(std::vector<Vec3<S>> points, const Config& config = {})
+      : points_(std::move(points)) {
+    if (points_.size() >= std::numeric_limits<std::uint32_t>::max()) {
+      throw std::invalid_argument("UniformGrid: more than 2^32 - 1 points");
+    }
+    if (!(config.cell >= S(0)) || !std::isfinite(config.cell) || config.max_cells == 0) {
+      throw std::invalid_argument(
+          "UniformGrid::Config: cell must be finite and >= 0, "
+          "max_cells >= 1");
+    }
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      if (!points_[i].allFinite()) {
+        throw std::invalid_argument("UniformGrid: point " + std::to_string(i) + " is not finite");
+      }
+    }
+    if (points_.empty()) return;
+    lo_ = points_.front();
+    Vec3<S> hi = lo_;
+    for (const auto& p : points_) {
+      lo_ = lo_.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    const Vec3<S> extent = hi - lo_;
+    double cell = config.cell > S(0) ? static_cast<double>(config.cell) : default_cell();
+    for (;;) {
+      std::array<double, 3> n{};
+      double total = 1.0;
+      for (int a = 0; a < 3; ++a) {
+        n[static_cast<std::size_t>(a)] = std::floor(static_cast<double>(extent[a]) / cell) + 1.0;
+        total *= n[static_cast<std::size_t>(a)];
+      }
+      if (total <= static_cast<double>(config.max_cells)) {
+        for (int a = 0; a < 3; ++a)
+          dims_[static_cast<std::size_t>(a)] = static_cast<int>(n[static_cast<std::size_t>(a)]);
+        break;
+      }
+      cell *= std::cbrt(total / static_cast<double>(config.max_cells)) * 1.01;
+    }
+    cell_ = static_cast<S>(cell);
+    inv_cell_ = S(1) / cell_;
+    const std::size_t cells = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
+    start_.assign(cells + 1, 0);
+    std::vector<std::uint32_t> cell_of(points_.size());
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      const auto c = cell_index(coord(points_[i]));
+      cell_of[i] = static_cast<std::uint32_t>(c);
+      ++start_[c + 1];
+    }
+    for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+    order_.resize(points_.size());
+    sorted_.resize(points_.size());
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < points_.size(); ++i) {  // ids ascend within each cell
+      const std::uint32_t slot = fill[cell_of[i]]++;
+      order_[slot] = static_cast<PointId>(i);
+      sorted_[slot] = points_[i];
+    }
+  }
+
+  /// Number of points.
+  [[nodiscard]] std::size_t size() const noexcept { return points_.size(); }
+  /// All points, indexed by id.
+  [[nodiscard]] const std::vector<Vec3<S>>& points() const noexcept { return points_; }
+  /// The cell edge [m].
+  [[nodiscard]] S cell() const noexcept { return cell_; }
+  /// Heap bytes held.
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    return points_.capacity() * sizeof(Vec3<S>) * 2 + start_.capacity() * sizeof(std::uint32_t) +
+           order_.capacity() * sizeof(PointId);
+  }
+
+  /// The closest point within distance r of q (ties by id), if any.
+  [[nodiscard]] std::optional<Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
+    if (points_.empty() || !q.allFinite() || !(r >= S(0))) return std::nullopt;
+    Neighbor<S> best{0, r * r};
+    bool found = false;
+    search(
+        q, r,
+        [&](PointId id, S d2) {
+          if (d2 < best.squared_distance ||
+              (d2 == best.squared_distance && (!found || id < best.id))) {
+            best = {id, d2};
+            found = true;
+          }
+        },
+        [&] { return best.squared_distance; });
+    return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
+  }
+
+  /// The min(k, size()) closest points, ordered by `closer`.
+  [[nodiscard]] std::vector<Neighbor<S>> knn(const Vec3<S>& q, std::size_t k) const {
+    k = std::min(k, size());
+    std::vector<Neighbor<S>> out;
+    if (k == 0 || !q.allFinite()) return out;
+    out.reserve(k + 1);
+    const S inf = std::numeric_limits<S>::infinity();
+    search(
+        q, inf,
+        [&](PointId id, S d2) {
+          const Neighbor<S> n{id, d2};
+          if (out.size() == k && !closer(n, out.back())) return;
+          out.insert(std::upper_bound(out.begin(), out.end(), n, closer<S>), n);
+          if (out.size() > k) out.pop_back();
+        },
+        [&] { return out.size() < k ? inf : out.back().squared_distance; });
+    return out;
+  }
+
+  /// Every point within distance r of q, ordered by `closer`.
+  [[nodiscard]] std::vector<Neighbor<S>> within(const Vec3<S>& q, S r) const {
+    std::vector<Neighbor<S>> out;
+    if (points_.empty() || !q.allFinite() || !(r >= S(0))) return out;
+    const S r2 = r * r;
+    search(
+        q, r,
+        [&](PointId id, S d2) {
+          if (d2 <= r2) out.push_back({id, d2});
+        },
+        [&] { return r2; });
+    std::sort(out.begin(), out.end(), closer<S>);
+    return out;
+  }
+
+ private:
+  // Twice the mean nearest-neighbour distance of up to 64 evenly spread points (brute force).
+  [[nodiscard]] double default_cell() const {
+    const std::size_t n = points_.size();
+    const std::size_t samples = std::min<std::size_t>(n, 64);
+    double sum = 0.0;
+    std::size_t counted = 0;
+    for (std::size_t s = 0; s < samples; ++s) {
+      const std::size_t i = s * n / samples;
+      S best = std::numeric_limits<S>::infinity();
+      for (std::size_t j = 0; j < n; ++j) {
+        const S d2 = squared_distance(points_[i], points_[j]);
+        if (j != i && d2 > S(0)) best = std::min(best, d2);
+      }
+      if (std::isfinite(static_cast<double>(best))) {
+        sum += std::sqrt(static_cast<double>(best));
+        ++counted;
+      }
+    }
+    return counted == 0 ? 1.0 : std::max(2.0 * sum / static_cast<double>(counted), 1e-9);
+  }
+
+  [[nodiscard]] Vec3<S> coord(const Vec3<S>& p) const { return (p - lo_) * inv_cell_; }
+  [[nodiscard]] std::size_t cell_index(const Vec3<S>& c) const {
+    std::array<int, 3> i{};
+    for (int a = 0; a < 3; ++a) {
+      i[static_cast<std::size_t>(a)] =
+          std::clamp(static_cast<int>(std::floor(c[a])), 0, dims_[static_cast<std::size_t>(a)] - 1);
+    }
+    return (static_cast<std::size_t>(i[2]) * dims_[1] + i[1]) * dims_[0] + i[0];
+  }
+
+  // Visits the points of shells of cells around q, ring 0 (q's cell) outwards, calling
+  // visit(id, d2) for each; stops when bound() (the current squared search radius, <= r^2 or
+  // infinite) is below the squared distance from q to every unvisited cell, or r is exceeded.
+  template <class Visit, class Bound>
+  void search(const Vec3<S>& q, S r, Visit&& visit, Bound&& bound) const {
+    // Cell coordinates, clamped far outside the grid so that they fit an int.
+    const Vec3<S> c = coord(q).cwiseMax(S(-1e8)).cwiseMin(S(1e8));
+    std::array<int, 3> home{};
+    // Distance (in cells) from q to the box of cells [home - k, home + k] per axis is at
+    // least k - frac..., tracked as the gap to the nearest unvisited layer.
+    double inner = std::numeric_limits<double>::infinity();  // q to its cell's nearest face
+    for (int a = 0; a < 3; ++a) {
+      const double x = static_cast<double>(c[a]);
+      const int cell = static_cast<int>(std::floor(x));
+      home[static_cast<std::size_t>(a)] = cell;
+      inner = std::min(inner, std::min(x - cell, cell + 1 - x));
+    }
+    // Cells outside the grid are empty: rings before `first` and after `last` hold nothing.
+    int first = 0;
+    int last = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int h = home[static_cast<std::size_t>(a)];
+      const int d = dims_[static_cast<std::size_t>(a)];
+      first = std::max(first, std::max(-h, h - (d - 1)));
+      last = std::max(last, std::max(h, d - 1 - h));
+    }
+    const double cell = static_cast<double>(cell_);
+    const double r_cells = std::isinf(static_cast<double>(r))
+                               ? std::numeric_limits<double>::infinity()
+                               : static_cast<double>(r) / cell;
+    for (int k = first; k <= last; ++k) {
+      // Every point in ring k is at least (k - 1 + inner) cells away (0 for k = 0).
+      const double gap = k == 0 ? 0.0 : (k - 1 + std::max(inner, 0.0));
+      if (gap > r_cells) return;
+      const double g = gap * cell;
+      if (k > 0 && static_cast<double>(bound()) < g * g) return;
+      visit_ring(home, k, q, visit);
+    }
+  }
+
+  template <class Visit>
+  void visit_ring(const std::array<int, 3>& h, int k, const Vec3<S>& q, Visit& visit) const {
+    const int z0 = std::max(h[2] - k, 0), z1 = std::min(h[2] + k, dims_[2] - 1);
+    const int y0 = std::max(h[1] - k, 0), y1 = std::min(h[1] + k, dims_[1] - 1);
+    const int x0 = std::max(h[0] - k, 0), x1 = std::min(h[0] + k, dims_[0] - 1);
+    for (int z = z0; z <= z1; ++z) {
+      const bool zedge = z == h[2] - k || z == h[2] + k;
+      for (int y = y0; y <= y1; ++y) {
+        const bool yedge = zedge || y == h[1] - k || y == h[1] + k;
+        const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
+        if (yedge) {
+          visit_cells(row + x0, row + x1 + 1, q, visit);
+        } else {  // interior rows of the shell: only the two end cells
+          const int left = h[0] - k;
+          const int right = h[0] + k;
+          if (left >= 0 && left < dims_[0]) visit_cells(row + left, row + left + 1, q, visit);
+          if (right >= 0 && right < dims_[0] && k > 0) {
+            visit_cells(row + right, row + right + 1, q, visit);
+          }
+        }
+      }
+    }
+  }
+
+  template <class Visit>
+  void visit_cells(std::size_t from, std::size_t to, const Vec3<S>& q, Visit& visit) const {
+    for (std::uint32_t s = start_[from], e = start_[to]; s < e; ++s) {
+      visit(order_[s], squared_distance(sorted_[s], q));
+    }
+  }
+
+  std::vector<Vec3<S>> points_;
+  std::vector<Vec3<S>> sorted_;       // points in cell order
+  std::vector<PointId> order_;        // id of each sorted point
+  std::vector<std::uint32_t> start_;  // CSR offsets, one per cell + 1
+  std::array<int, 3> dims_{1, 1, 1};
+  Vec3<S> lo_ = Vec3<S>::Zero();
+  S cell_ = S(1);
+  S inv_cell_ = S(1);
+};
+
+}  // namespace taxel::index

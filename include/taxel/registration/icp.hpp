@@ -1,0 +1,418 @@
+// SPDX-License-Identifier: MIT
+// Iterative closest point over a preprocessed Target, composed at compile time from an error
+// policy (PointToPoint: closed-form weighted Kabsch/Umeyama with the reflection fix;
+// PointToPlane: Gauss-Newton on a 6-D twist) and a robust kernel, with correspondence
+// rejection by distance and by trimming. The Icp object is a workspace: after the first
+// alignment of a source of a given size, iterations allocate nothing.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "taxel/core/point_cloud.hpp"
+#include "taxel/core/status.hpp"
+#include "taxel/registration/kernels.hpp"
+#include "taxel/registration/target.hpp"
+
+namespace taxel::registration {
+
+using Mat6d = Eigen::Matrix<double, 6, 6>;
+using Vec6d = Eigen::Matrix<double, 6, 1>;
+
+/// Options of Icp. Distances in metres, angles in radians.
+struct IcpConfig {
+  int max_iterations = 50;  ///< >= 1
+  /// Correspondences farther apart than this are rejected (> 0; infinity keeps all).
+  double max_distance = std::numeric_limits<double>::infinity();
+  /// After the distance gate, drop this fraction of the worst correspondences, [0, 1).
+  double trim_fraction = 0.0;
+  double translation_tolerance = 1e-6;  ///< converged when an update moves less than this...
+  double rotation_tolerance = 1e-6;     ///< ...and turns less than this
+  /// Also converged when the RMSE changes by less than this fraction of itself (0: off).
+  double relative_error_tolerance = 0.0;
+  /// Fewest correspondences to solve with; 0 means the error policy's minimum (3 or 6).
+  std::size_t min_correspondences = 0;
+  /// Take correspondences from the target's closest-point field where it has one (a single
+  /// lookup, off by up to half a field cell diagonal) and search exactly elsewhere. For coarse
+  /// stages; the final iterations of an accurate alignment should be exact.
+  bool approximate = false;
+};
+
+/// The outcome of one alignment. `ok`: converged; `not_converged`: the iteration cap was hit
+/// (the last iterate is returned); `degenerate`: the geometry does not fix the pose (too few
+/// points or correspondences, collinear points, or for point-to-plane a plane, sphere or
+/// cylinder patch); transform and RMSE are still those of the last iterate, never NaN;
+/// `invalid_input`: a bad initial transform.
+struct IcpResult : Outcome {
+  Isometry3d transform = Isometry3d::Identity();  ///< T_target_source
+  double rmse = 0.0;             ///< RMS Euclidean distance of the inlier pairs [m]
+  double inlier_fraction = 0.0;  ///< inliers / finite source points
+  std::size_t inliers = 0;       ///< pairs kept by the distance gate and trimming
+  std::size_t skipped = 0;       ///< non-finite source points, ignored
+  int iterations = 0;            ///< updates applied
+  /// Sum of J'J over the inlier pairs at the final pose, twist order (rotation, translation)
+  /// about the target frame's origin, unit weights: divide by the residual variance for the
+  /// Fisher information of the pose.
+  Mat6d information = Mat6d::Zero();
+};
+
+/// One source-target pair of an iteration.
+struct Correspondence {
+  Vec3d p;                ///< source point under the current transform
+  Vec3d q;                ///< its nearest target point
+  Vec3d n;                ///< the target normal at q
+  double d2 = 0.0;        ///< |p - q|^2
+  double residual = 0.0;  ///< the error policy's residual magnitude
+  double weight = 1.0;    ///< the kernel's weight
+};
+
+/// Minimises sum w |p - q|^2: closed form (weighted Kabsch with the reflection fix).
+struct PointToPoint {
+  static constexpr std::string_view name = "point-to-point";
+  static constexpr std::size_t min_correspondences = 3;
+
+  [[nodiscard]] static double residual(const Correspondence& c) noexcept { return std::sqrt(c.d2); }
+
+  /// The update `delta` (applied on the left) minimising the weighted error, or `degenerate`
+  /// when the source points are collinear.
+  static Outcome solve(std::span<const Correspondence> cs, Isometry3d& delta) {
+    double wsum = 0.0;
+    Vec3d pm = Vec3d::Zero(), qm = Vec3d::Zero();
+    for (const auto& c : cs) {
+      wsum += c.weight;
+      pm += c.weight * c.p;
+      qm += c.weight * c.q;
+    }
+    if (!(wsum > 0.0)) return {Status::degenerate, "every correspondence has zero weight"};
+    pm /= wsum;
+    qm /= wsum;
+    Mat3d h = Mat3d::Zero(), spread = Mat3d::Zero();
+    for (const auto& c : cs) {
+      const Vec3d dp = c.p - pm;
+      h += c.weight * dp * (c.q - qm).transpose();
+      spread += c.weight * dp * dp.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Mat3d> eig(spread, Eigen::EigenvaluesOnly);
+    if (!(eig.eigenvalues()(1) > 1e-12 * eig.eigenvalues()(2))) {
+      return {Status::degenerate,
+              "the source points are collinear: the rotation about their "
+              "line is not determined"};
+    }
+    const Eigen::JacobiSVD<Mat3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Mat3d d = Mat3d::Identity();
+    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    const Mat3d r = svd.matrixV() * d * svd.matrixU().transpose();
+    delta.setIdentity();
+    delta.linear() = r;
+    delta.translation() = qm - r * pm;
+    return {};
+  }
+
+  /// Adds J'J of the 3-D residual p - q (J = [-[p]x, I]).
+  static void add_information(const Correspondence& c, Mat6d& info) {
+    Eigen::Matrix<double, 3, 6> j;
+    j.leftCols<3>() << 0.0, c.p.z(), -c.p.y(), -c.p.z(), 0.0, c.p.x(), c.p.y(), -c.p.x(), 0.0;
+    j.rightCols<3>().setIdentity();
+    info.noalias() += j.transpose() * j;
+  }
+};
+
+/// Minimises sum w (n . (p - q))^2 by Gauss-Newton on a twist about the source centroid,
+/// J'J accumulated in closed form. Directions the target's geometry leaves free (eigenvalues of
+/// J'J at the target points, rotations scaled by the source's RMS radius, below 1e-6 of the
+/// largest) are not moved and make the result `degenerate`.
+struct PointToPlane {
+  static constexpr std::string_view name = "point-to-plane";
+  static constexpr std::size_t min_correspondences = 6;
+  static constexpr double kFreeDirection = 1e-6;
+
+  [[nodiscard]] static double residual(const Correspondence& c) noexcept {
+    return std::fabs(c.n.dot(c.p - c.q));
+  }
+
+  static Outcome solve(std::span<const Correspondence> cs, Isometry3d& delta) {
+    double wsum = 0.0;
+    Vec3d centre = Vec3d::Zero();
+    for (const auto& c : cs) {
+      wsum += c.weight;
+      centre += c.weight * c.p;
+    }
+    if (!(wsum > 0.0)) return {Status::degenerate, "every correspondence has zero weight"};
+    centre /= wsum;
+    double spread = 0.0;
+    for (const auto& c : cs) spread += c.weight * (c.p - centre).squaredNorm();
+    // Rotations scaled by the source's RMS radius so both blocks are in metres.
+    const double len = std::max(std::sqrt(spread / wsum), 1e-12);
+    // h, g: the Gauss-Newton system at the source points. hq: the same at the target points,
+    // whose null space is exactly the motions the target's shape leaves free (a plane's
+    // in-plane slides and spin, a sphere's rotations about its centre, a cylinder's axis), so
+    // degeneracy is decided on hq and the step is taken in the directions it constrains.
+    Mat6d h = Mat6d::Zero();
+    Mat6d hq = Mat6d::Zero();
+    Vec6d g = Vec6d::Zero();
+    for (const auto& c : cs) {
+      Vec6d j;
+      j.head<3>() = (c.p - centre).cross(c.n) / len;
+      j.tail<3>() = c.n;
+      const double r = c.n.dot(c.p - c.q);
+      h.selfadjointView<Eigen::Lower>().rankUpdate(j, c.weight);
+      g.noalias() += (c.weight * r) * j;
+      j.head<3>() = (c.q - centre).cross(c.n) / len;
+      hq.selfadjointView<Eigen::Lower>().rankUpdate(j, c.weight);
+    }
+    h = h.selfadjointView<Eigen::Lower>();
+    hq = hq.selfadjointView<Eigen::Lower>();
+    const Eigen::SelfAdjointEigenSolver<Mat6d> eig(hq);
+    const double top = eig.eigenvalues()(5);
+    if (!(top > 0.0)) return {Status::degenerate, "the normals constrain no direction"};
+    int free = 0;
+    while (free < 6 && eig.eigenvalues()(free) <= kFreeDirection * top) ++free;
+    Vec6d x;
+    if (free == 0) {
+      x = -h.ldlt().solve(g);
+    } else {  // Newton step within the constrained subspace N: x = -N (N'hN)^-1 N'g
+      const auto n = eig.eigenvectors().rightCols(6 - free);
+      const Eigen::MatrixXd reduced = n.transpose() * h * n;
+      x = -n * reduced.ldlt().solve(n.transpose() * g);
+    }
+    const Vec3d omega = x.head<3>() / len;
+    const Vec3d v = x.tail<3>();
+    const double angle = omega.norm();
+    const Mat3d r = angle > 0.0 ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix()
+                                : Mat3d::Identity();
+    delta.setIdentity();
+    delta.linear() = r;
+    delta.translation() = centre + v - r * centre;
+    if (free > 0) {
+      return {Status::degenerate,
+              std::to_string(free) +
+                  " of 6 pose directions are not constrained by the target's normals "
+                  "(a plane, sphere or cylinder patch): the pose is one of many equally good "
+                  "fits"};
+    }
+    return {};
+  }
+
+  /// Adds J'J of the scalar residual n . (p - q) (J = [p x n, n]).
+  static void add_information(const Correspondence& c, Mat6d& info) {
+    Vec6d j;
+    j.head<3>() = c.p.cross(c.n);
+    j.tail<3>() = c.n;
+    info.selfadjointView<Eigen::Lower>().rankUpdate(j);
+  }
+};
+
+/// An ICP error policy.
+template <class E>
+concept IcpError = requires(const Correspondence& c, std::span<const Correspondence> cs,
+                            Isometry3d& t, Mat6d& m) {
+  { E::residual(c) } -> std::convertible_to<double>;
+  { E::solve(cs, t) } -> std::convertible_to<Outcome>;
+  E::add_information(c, m);
+  { E::min_correspondences } -> std::convertible_to<std::size_t>;
+};
+
+/// ICP. `align` may be called any number of times, on any targets; not thread-safe (one Icp
+/// per thread), while Targets may be shared.
+template <IcpError Error = PointToPlane, RobustKernel Kernel = NoKernel>
+class Icp {
+ public:
+  /// Throws std::invalid_argument naming the first bad field.
+  explicit Icp(IcpConfig cfg = {}, Kernel kernel = {}) : cfg_(cfg), kernel_(kernel) {
+    const auto bad = [](const std::string& what) {
+      throw std::invalid_argument("IcpConfig::" + what);
+    };
+    if (cfg.max_iterations < 1) bad("max_iterations must be >= 1");
+    if (!(cfg.max_distance > 0.0)) bad("max_distance must be > 0");
+    if (!(cfg.trim_fraction >= 0.0 && cfg.trim_fraction < 1.0))
+      bad("trim_fraction must be in [0, 1)");
+    if (!(cfg.translation_tolerance >= 0.0) || !(cfg.rotation_tolerance >= 0.0) ||
+        !(cfg.relative_error_tolerance >= 0.0)) {
+      bad("tolerances must be >= 0");
+    }
+  }
+
+  /// Aligns `source` to `target` from `initial` (T_target_source).
+  template <Scalar S>
+  IcpResult align(const Target<S>& target, std::span<const Vec3<S>> source,
+                  const Isometry3d& initial = Isometry3d::Identity()) {
+    IcpResult res;
+    res.transform = initial;
+    if (!initial.matrix().allFinite() ||
+        !(initial.linear() * initial.linear().transpose()).isIdentity(1e-6) ||
+        !(initial.linear().determinant() > 0.0)) {
+      res.status = Status::invalid_input;
+      res.message = "the initial transform is not a finite rotation and translation";
+      res.transform.setIdentity();
+      return res;
+    }
+    src_.clear();
+    src_.reserve(source.size());
+    for (const auto& p : source) {
+      if (p.allFinite()) {
+        src_.push_back(p.template cast<double>());
+      } else {
+        ++res.skipped;
+      }
+    }
+    const std::size_t need = std::max<std::size_t>(
+        cfg_.min_correspondences == 0 ? Error::min_correspondences : cfg_.min_correspondences,
+        Error::min_correspondences);
+    if (src_.size() < need) {
+      res.status = Status::degenerate;
+      res.message = std::to_string(src_.size()) + " finite source points; " +
+                    std::string(Error::name) + " needs at least " + std::to_string(need);
+      return res;
+    }
+    // Spatially coherent order (by 5 mm blocks): neighbouring queries touch the same cells.
+    std::sort(src_.begin(), src_.end(), [](const Vec3d& a, const Vec3d& b) {
+      const auto block = [](const Vec3d& p) {
+        return std::array<double, 3>{std::floor(p.z() * 200.0), std::floor(p.y() * 200.0), p.x()};
+      };
+      return block(a) < block(b);
+    });
+    pairs_.reserve(src_.size());
+    scratch_.reserve(src_.size());
+
+    Isometry3d t = initial;
+    double previous_rmse = std::numeric_limits<double>::infinity();
+    Outcome last{};
+    bool converged = false;
+    for (int it = 0; it < cfg_.max_iterations; ++it) {
+      const double rmse = correspond(target, t);
+      if (pairs_.size() < need) {
+        return finish(res, target, t, Status::degenerate,
+                      std::to_string(pairs_.size()) + " correspondences within max_distance; " +
+                          std::string(Error::name) + " needs at least " + std::to_string(need));
+      }
+      if (cfg_.relative_error_tolerance > 0.0 &&
+          std::fabs(previous_rmse - rmse) <= cfg_.relative_error_tolerance * rmse) {
+        converged = true;
+        break;
+      }
+      previous_rmse = rmse;
+      Isometry3d delta;
+      last = Error::solve(pairs_, delta);
+      if (!delta.matrix().allFinite()) {
+        return finish(res, target, t, Status::degenerate, "the update is not finite");
+      }
+      if (last.status == Status::degenerate && Error::min_correspondences == 3) {
+        return finish(res, target, t, Status::degenerate, last.message);  // nothing to apply
+      }
+      t = delta * t;
+      // Re-orthonormalise against drift over many updates.
+      t.linear() = Eigen::Quaterniond(t.linear()).normalized().toRotationMatrix();
+      ++res.iterations;
+      const double angle = Eigen::AngleAxisd(delta.linear()).angle();
+      if (delta.translation().norm() <= cfg_.translation_tolerance &&
+          angle <= cfg_.rotation_tolerance) {
+        converged = true;
+        break;
+      }
+    }
+    if (last.status == Status::degenerate) {
+      return finish(res, target, t, Status::degenerate, last.message);
+    }
+    if (!converged) {
+      return finish(res, target, t, Status::not_converged,
+                    "reached max_iterations = " + std::to_string(cfg_.max_iterations) +
+                        " before the update fell below the tolerances");
+    }
+    return finish(res, target, t, Status::ok, {});
+  }
+
+  /// Aligns the points of `source`.
+  template <Scalar S>
+  IcpResult align(const Target<S>& target, const PointCloud<S>& source,
+                  const Isometry3d& initial = Isometry3d::Identity()) {
+    return align(target, std::span<const Vec3<S>>(source.points), initial);
+  }
+
+  [[nodiscard]] const IcpConfig& config() const noexcept { return cfg_; }
+  [[nodiscard]] const Kernel& kernel() const noexcept { return kernel_; }
+
+ private:
+  // Fills pairs_ at transform t (gate, trimming, kernel weights); returns the inlier RMSE.
+  template <Scalar S>
+  double correspond(const Target<S>& target, const Isometry3d& t) {
+    pairs_.clear();
+    const auto& pts = target.points();
+    const auto& nrm = target.normals();
+    const S gate = static_cast<S>(std::min(cfg_.max_distance, 1e300));
+    const double gate2 = cfg_.max_distance * cfg_.max_distance;
+    for (const Vec3d& s : src_) {
+      const Vec3d p = t * s;
+      const Vec3<S> ps = p.template cast<S>();
+      index::PointId id = 0;
+      if (const auto approx = cfg_.approximate ? target.field_nearest(ps) : std::nullopt) {
+        id = *approx;
+      } else if (const auto nb = target.nearest_within(ps, gate)) {
+        id = nb->id;
+      } else {
+        continue;
+      }
+      Correspondence c;
+      c.p = p;
+      c.q = pts[id].template cast<double>();
+      c.n = nrm[id].template cast<double>();
+      c.d2 = (c.p - c.q).squaredNorm();
+      if (c.d2 > gate2) continue;
+      pairs_.push_back(c);
+    }
+    if (cfg_.trim_fraction > 0.0 && pairs_.size() > 1) {
+      const auto keep = static_cast<std::size_t>(
+          std::ceil((1.0 - cfg_.trim_fraction) * static_cast<double>(pairs_.size())));
+      if (keep < pairs_.size()) {
+        scratch_.clear();
+        for (const auto& c : pairs_) scratch_.push_back(c.d2);
+        std::nth_element(scratch_.begin(), scratch_.begin() + static_cast<std::ptrdiff_t>(keep - 1),
+                         scratch_.end());
+        const double limit = scratch_[keep - 1];
+        std::erase_if(pairs_, [limit](const Correspondence& c) { return c.d2 > limit; });
+      }
+    }
+    double sum = 0.0;
+    for (auto& c : pairs_) {
+      c.residual = Error::residual(c);
+      c.weight = kernel_.weight(c.residual);
+      sum += c.d2;
+    }
+    return pairs_.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(pairs_.size()));
+  }
+
+  template <Scalar S>
+  IcpResult& finish(IcpResult& res, const Target<S>& target, const Isometry3d& t, Status status,
+                    std::string message) {
+    res.transform = t;
+    res.status = status;
+    res.message = std::move(message);
+    res.rmse = correspond(target, t);
+    res.inliers = pairs_.size();
+    res.inlier_fraction =
+        src_.empty() ? 0.0 : static_cast<double>(pairs_.size()) / static_cast<double>(src_.size());
+    res.information.setZero();
+    for (const auto& c : pairs_) Error::add_information(c, res.information);
+    res.information = res.information.template selfadjointView<Eigen::Lower>();
+    return res;
+  }
+
+  IcpConfig cfg_;
+  Kernel kernel_;
+  std::vector<Vec3d> src_;
+  std::vector<Correspondence> pairs_;
+  std::vector<double> scratch_;
+};
+
+}  // namespace taxel::registration

@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: MIT
+// Surface sampling of the analytic shapes: uniform (area-weighted) point clouds with exact
+// normals, for ICP models and ground truth; and partial "tactile" clouds made of a few touched
+// patches with noise, like the clouds a hand gathers.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "taxel/core/point_cloud.hpp"
+#include "taxel/sim/shapes.hpp"
+
+namespace taxel::sim {
+
+/// Surface area [m^2].
+inline double surface_area(const Sphere& s) { return 4.0 * std::numbers::pi * s.radius * s.radius; }
+/// Surface area [m^2] (side and both caps).
+inline double surface_area(const Cylinder& c) {
+  return 2.0 * std::numbers::pi * c.radius * (2.0 * c.half_height + c.radius);
+}
+/// Surface area [m^2].
+inline double surface_area(const Box& b) {
+  const Vec3d e = 2.0 * b.half_extents;
+  return 2.0 * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x());
+}
+
+/// One point drawn uniformly over the surface (by area), with its outward normal.
+template <class Rng>
+void sample_point(const Sphere& s, Rng& rng, Vec3d& p, Vec3d& n) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  Vec3d d(g(rng), g(rng), g(rng));
+  while (d.squaredNorm() < 1e-24) d = Vec3d(g(rng), g(rng), g(rng));
+  n = d.normalized();
+  p = s.radius * n;
+}
+
+template <class Rng>
+void sample_point(const Cylinder& c, Rng& rng, Vec3d& p, Vec3d& n) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double side = 2.0 * std::numbers::pi * c.radius * 2.0 * c.half_height;
+  const double cap = std::numbers::pi * c.radius * c.radius;
+  const double pick = u(rng) * (side + 2.0 * cap);
+  const double phi = 2.0 * std::numbers::pi * u(rng);
+  if (pick < side) {
+    n = Vec3d(std::cos(phi), std::sin(phi), 0.0);
+    p = Vec3d(c.radius * n.x(), c.radius * n.y(), c.half_height * (2.0 * u(rng) - 1.0));
+    return;
+  }
+  const double r = c.radius * std::sqrt(u(rng));  // uniform over the disc
+  const double z = pick < side + cap ? c.half_height : -c.half_height;
+  p = Vec3d(r * std::cos(phi), r * std::sin(phi), z);
+  n = Vec3d(0.0, 0.0, z > 0 ? 1.0 : -1.0);
+}
+
+template <class Rng>
+void sample_point(const Box& b, Rng& rng, Vec3d& p, Vec3d& n) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Vec3d h = b.half_extents;
+  const std::array<double, 3> face{h.y() * h.z(), h.x() * h.z(), h.x() * h.y()};  // per axis
+  double pick = u(rng) * 2.0 * (face[0] + face[1] + face[2]);
+  int axis = 0;
+  while (axis < 2 && pick >= 2.0 * face[static_cast<std::size_t>(axis)]) {
+    pick -= 2.0 * face[static_cast<std::size_t>(axis)];
+    ++axis;
+  }
+  const double sign = pick < face[static_cast<std::size_t>(axis)] ? 1.0 : -1.0;
+  for (int k = 0; k < 3; ++k) p[k] = h[k] * (2.0 * u(rng) - 1.0);
+  p[axis] = sign * h[axis];
+  n = Vec3d::Zero();
+  n[axis] = sign;
+}
+
+/// Concept of a shape that sample_point can draw from.
+template <class Sh>
+concept SampleableShape = Shape<Sh> && requires(const Sh& s, std::mt19937_64& rng, Vec3d& v) {
+  sample_point(s, rng, v, v);
+};
+
+/// `count` points drawn uniformly over the surface with their exact outward normals.
+/// Deterministic for a seed.
+template <SampleableShape Sh>
+PointCloud<double> sample_surface(const Sh& shape, std::size_t count, std::uint64_t seed = 1) {
+  std::mt19937_64 rng(seed);
+  PointCloud<double> cloud;
+  cloud.points.resize(count);
+  cloud.normals.resize(count);
+  for (std::size_t i = 0; i < count; ++i)
+    sample_point(shape, rng, cloud.points[i], cloud.normals[i]);
+  return cloud;
+}
+
+/// What a hand touching an object a few times gathers.
+struct PatchConfig {
+  int patches = 5;            ///< touched patches, >= 1
+  double radius = 0.015;      ///< patch radius [m], > 0
+  std::size_t points = 2000;  ///< points in the cloud, >= 1
+  double sigma = 1e-3;        ///< isotropic Gaussian noise [m], >= 0
+};
+
+/// A partial cloud of `cfg.points` points: patch centres drawn uniformly over the surface, and
+/// points drawn uniformly over the surface within `radius` (Euclidean) of some centre, plus
+/// noise. Exact normals of the noise-free points. Deterministic for a seed. Throws
+/// std::invalid_argument for a bad configuration.
+template <SampleableShape Sh>
+PointCloud<double> tactile_patches(const Sh& shape, const PatchConfig& cfg,
+                                   std::uint64_t seed = 1) {
+  if (cfg.patches < 1 || !(cfg.radius > 0) || cfg.points < 1 || !(cfg.sigma >= 0) ||
+      !std::isfinite(cfg.radius) || !std::isfinite(cfg.sigma)) {
+    throw std::invalid_argument(
+        "PatchConfig: patches and points must be >= 1, radius > 0 and sigma >= 0 (finite)");
+  }
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_int_distribution<int> which(0, cfg.patches - 1);
+  std::vector<Vec3d> centres(static_cast<std::size_t>(cfg.patches));
+  Vec3d p, n;
+  for (auto& c : centres) sample_point(shape, rng, c, n);
+  PointCloud<double> cloud;
+  cloud.points.reserve(cfg.points);
+  cloud.normals.reserve(cfg.points);
+  const double r2 = cfg.radius * cfg.radius;
+  // Rejection sampling per patch keeps the density uniform over each patch's surface. A patch
+  // smaller than the object's sampling density would starve; give up after many misses.
+  std::size_t misses = 0;
+  while (cloud.points.size() < cfg.points) {
+    const Vec3d& c = centres[static_cast<std::size_t>(which(rng))];
+    sample_point(shape, rng, p, n);
+    if ((p - c).squaredNorm() > r2) {
+      if (++misses > 1000 * cfg.points + 100000) {
+        throw std::invalid_argument("tactile_patches: the patches are too small for the shape");
+      }
+      continue;
+    }
+    cloud.points.push_back(p + cfg.sigma * Vec3d(g(rng), g(rng), g(rng)));
+    cloud.normals.push_back(n);
+  }
+  return cloud;
+}
+
+}  // namespace taxel::sim
