@@ -67,7 +67,9 @@ class UniformGrid {
       std::array<double, 3> n{};
       double total = 1.0;
       for (int a = 0; a < 3; ++a) {
-        n[static_cast<std::size_t>(a)] = std::floor(static_cast<double>(extent[a]) / cell) + 1.0;
+        // One empty cell of padding on each side: queries just outside the points' box still
+        // take the fast path.
+        n[static_cast<std::size_t>(a)] = std::floor(static_cast<double>(extent[a]) / cell) + 3.0;
         total *= n[static_cast<std::size_t>(a)];
       }
       if (total <= static_cast<double>(config.max_cells)) {
@@ -79,6 +81,7 @@ class UniformGrid {
     }
     cell_ = static_cast<S>(cell);
     inv_cell_ = S(1) / cell_;
+    lo_ -= Vec3<S>::Constant(cell_);
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
     start_.assign(cells + 1, 0);
     std::vector<std::uint32_t> cell_of(points_.size());
@@ -115,16 +118,19 @@ class UniformGrid {
     if (points_.empty() || !q.allFinite() || !(r >= S(0))) return std::nullopt;
     Neighbor<S> best{0, r * r};
     bool found = false;
-    search(
-        q, r,
-        [&](PointId id, S d2) {
-          if (d2 < best.squared_distance ||
-              (d2 == best.squared_distance && (!found || id < best.id))) {
-            best = {id, d2};
-            found = true;
-          }
-        },
-        [&] { return best.squared_distance; });
+    const auto keep = [&](PointId id, S d2) {
+      if (d2 < best.squared_distance || (d2 == best.squared_distance && (!found || id < best.id))) {
+        best = {id, d2};
+        found = true;
+      }
+    };
+    // Fast path: the 2 x 2 x 2 block of cells nearest to q. Every point outside it is at
+    // least `margin` away, so a strictly closer answer is final.
+    const S margin = visit_block(q, keep);
+    if (found && best.squared_distance < margin * margin) return best;
+    found = false;
+    best = {0, r * r};
+    search(q, r, keep, [&] { return best.squared_distance; });
     return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
   }
 
@@ -232,6 +238,35 @@ class UniformGrid {
       if (k > 0 && static_cast<double>(bound()) < g * g) return;
       visit_ring(home, k, q, visit);
     }
+  }
+
+  // Visits the 2 x 2 x 2 block of cells nearest to q (clipped to the grid); returns the
+  // distance from q to the nearest face of the block that borders unvisited cells (0 when q is
+  // outside the grid: no fast path).
+  template <class Visit>
+  S visit_block(const Vec3<S>& q, Visit& visit) const {
+    const Vec3<S> c = coord(q);
+    std::array<int, 3> lo{};
+    S margin = std::numeric_limits<S>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      const S x = c[a];
+      if (!(x >= S(0) && x < S(dims_[static_cast<std::size_t>(a)]))) return S(0);
+      const int cell = static_cast<int>(x);
+      const int first = x - S(cell) < S(0.5) ? cell - 1 : cell;  // block spans [first, first + 2)
+      lo[static_cast<std::size_t>(a)] = first;
+      // Distance to each block face, unless the grid ends there (nothing lies beyond).
+      if (first > 0) margin = std::min(margin, x - S(first));
+      if (first + 2 < dims_[static_cast<std::size_t>(a)])
+        margin = std::min(margin, S(first + 2) - x);
+    }
+    const int x0 = std::max(lo[0], 0), x1 = std::min(lo[0] + 1, dims_[0] - 1);
+    for (int z = std::max(lo[2], 0); z <= std::min(lo[2] + 1, dims_[2] - 1); ++z) {
+      for (int y = std::max(lo[1], 0); y <= std::min(lo[1] + 1, dims_[1] - 1); ++y) {
+        const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
+        visit_cells(row + x0, row + x1 + 1, q, visit);
+      }
+    }
+    return margin * cell_;
   }
 
   template <class Visit>

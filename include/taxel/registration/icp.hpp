@@ -167,13 +167,11 @@ struct PointToPlane {
       j.head<3>() = (c.p - centre).cross(c.n) / len;
       j.tail<3>() = c.n;
       const double r = c.n.dot(c.p - c.q);
-      h.selfadjointView<Eigen::Lower>().rankUpdate(j, c.weight);
+      h.noalias() += (c.weight * j) * j.transpose();
       g.noalias() += (c.weight * r) * j;
       j.head<3>() = (c.q - centre).cross(c.n) / len;
-      hq.selfadjointView<Eigen::Lower>().rankUpdate(j, c.weight);
+      hq.noalias() += (c.weight * j) * j.transpose();
     }
-    h = h.selfadjointView<Eigen::Lower>();
-    hq = hq.selfadjointView<Eigen::Lower>();
     const Eigen::SelfAdjointEigenSolver<Mat6d> eig(hq);
     const double top = eig.eigenvalues()(5);
     if (!(top > 0.0)) return {Status::degenerate, "the normals constrain no direction"};
@@ -276,13 +274,6 @@ class Icp {
                     std::string(Error::name) + " needs at least " + std::to_string(need);
       return res;
     }
-    // Spatially coherent order (by 5 mm blocks): neighbouring queries touch the same cells.
-    std::sort(src_.begin(), src_.end(), [](const Vec3d& a, const Vec3d& b) {
-      const auto block = [](const Vec3d& p) {
-        return std::array<double, 3>{std::floor(p.z() * 200.0), std::floor(p.y() * 200.0), p.x()};
-      };
-      return block(a) < block(b);
-    });
     pairs_.reserve(src_.size());
     scratch_.reserve(src_.size());
 

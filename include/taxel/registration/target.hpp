@@ -86,13 +86,15 @@ class Target {
   /// The kd-tree over the same points.
   [[nodiscard]] const index::KdTree<S>& kdtree() const noexcept { return tree_; }
 
-  /// The closest point within distance r of q (ties by id), if any: exact. With a
-  /// closest-point field, the point stored for q's cell bounds the answer from above (its
-  /// distance to q) and from below (its distance to the cell centre minus half the cell
-  /// diagonal), so far queries end at once and near ones search a small radius. The grid
-  /// serves searches up to three cells; the kd-tree those beyond.
+  /// The closest point within distance r of q (ties by id), if any: exact. The grid serves
+  /// searches up to three cells from q; beyond, the kd-tree, whose search the closest-point
+  /// field (when built) bounds from above (the stored point's distance to q) and from below
+  /// (its distance to the cell centre minus half the cell diagonal: far queries end at once).
   [[nodiscard]] std::optional<index::Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
     if (!(r >= S(0)) || !q.allFinite()) return std::nullopt;
+    const S near = S(3) * grid_.cell();
+    if (r <= near) return grid_.nearest_within(q, r);
+    if (auto nb = grid_.nearest_within(q, near)) return nb;  // nothing nearer lies beyond
     if (const auto cell = field_cell_of(q)) {
       const Vec3d qd = q.template cast<double>();
       const Vec3d p = grid_.points()[field_[*cell]].template cast<double>();
@@ -102,9 +104,6 @@ class Target {
       const double upper = (qd - p).norm();
       if (upper < static_cast<double>(r)) r = static_cast<S>(upper) * (S(1) + S(1e-6)) + S(1e-12);
     }
-    const S near = S(3) * grid_.cell();
-    if (r <= near) return grid_.nearest_within(q, r);
-    if (auto nb = grid_.nearest_within(q, near)) return nb;  // nothing nearer lies beyond
     return tree_.nearest_within(q, r);
   }
 
