@@ -6,4 +6,5 @@
 #include "taxel/io/image.hpp"
 #include "taxel/io/libsvm_format.hpp"
 #include "taxel/io/picture.hpp"
+#include "taxel/io/ply.hpp"
 #include "taxel/io/svg_plot.hpp"

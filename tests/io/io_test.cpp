@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Tests of taxel::io image readers and writers: round trips, foreign conventions, and malformed
 // inputs that must be refused with the place of the error.
+#include <bit>
 #include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -243,4 +244,106 @@ TEST_CASE("SVG line plots: points, legend, escaping, reversed axis, errors", "[i
   CHECK_THROWS_WITH(tio::render_svg(bad), Catch::Matchers::Contains("'broken' has 2 x values"));
   tio::LinePlot empty;
   CHECK(count(tio::render_svg(empty), "<circle") == 0);
+}
+
+TEST_CASE("PLY: ASCII and binary round trips, foreign files, strict errors", "[io][ply]") {
+  namespace tio = taxel::io;
+  taxel::PointCloud<double> cloud;
+  for (int i = 0; i < 5; ++i) {
+    cloud.points.emplace_back(0.1 * i, -0.25 * i, 1e-3 / (i + 1));
+    cloud.normals.emplace_back(0.0, i % 2 ? 1.0 : 0.0, i % 2 ? 0.0 : 1.0);
+  }
+  cloud.fields.push_back({"observations", {1, 2, 3, 4, 5}});
+  cloud.fields.push_back({"covariance_trace", {1e-6, 2e-6, 3.5e-7, 0.0, 1.0 / 3.0}});
+  const std::vector<std::array<std::uint32_t, 3>> tris{{0, 1, 2}, {2, 3, 4}};
+  for (const auto format : {tio::PlyFormat::ascii, tio::PlyFormat::binary_little_endian}) {
+    const tio::PlyData back = tio::parse_ply(tio::encode_ply(cloud, format, tris));
+    CHECK(back.cloud.points == cloud.points);  // exact: shortest round-trip text or raw bits
+    CHECK(back.cloud.normals == cloud.normals);
+    REQUIRE(back.cloud.fields.size() == 2);
+    CHECK(back.cloud.fields[1].name == "covariance_trace");
+    CHECK(back.cloud.fields[1].values == cloud.fields[1].values);
+    CHECK(back.triangles == tris);
+  }
+  // A foreign file: float and uchar colour properties, a comment, CRLF, a quad face.
+  const std::string foreign =
+      "ply\r\nformat ascii 1.0\r\ncomment made elsewhere\r\nelement vertex 4\r\n"
+      "property float x\r\nproperty float y\r\nproperty float z\r\nproperty uchar red\r\n"
+      "element face 1\r\nproperty list uchar int vertex_index\r\nend_header\r\n"
+      "0 0 0 255\r\n1 0 0 0\r\n1 1 0 10\r\n0 1 0 20\r\n4 0 1 2 3\r\n";
+  const tio::PlyData f = tio::parse_ply(foreign);
+  CHECK(f.cloud.size() == 4);
+  CHECK_FALSE(f.cloud.has_normals());
+  REQUIRE(f.cloud.field("red") != nullptr);
+  CHECK(f.cloud.field("red")->values[0] == 255);
+  CHECK(f.triangles.size() == 2);
+  // Binary float32 written by hand.
+  std::string bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  for (const float v : {1.5f, -2.0f, 0.25f, 3.0f, 4.0f, 5.0f}) {
+    const auto bits = std::bit_cast<std::uint32_t>(v);
+    for (int b = 0; b < 4; ++b) bin.push_back(static_cast<char>((bits >> (8 * b)) & 0xFF));
+  }
+  const tio::PlyData b = tio::parse_ply(bin);
+  CHECK(b.cloud.points[0] == taxel::Vec3d(1.5, -2.0, 0.25));
+  CHECK(b.cloud.points[1] == taxel::Vec3d(3.0, 4.0, 5.0));
+
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\n"
+      "property double y\nproperty double z\nend_header\n";
+  struct Bad {
+    std::string text;
+    const char* message;
+  };
+  const std::vector<Bad> bad{
+      {"plx\n", "<ply>:1: not a PLY file"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\n", "no end_header"},
+      {"ply\nformat binary_big_endian 1.0\nend_header\n", ":2: binary_big_endian"},
+      {"ply\nformat ascii 2.0\nend_header\n", ":2: malformed format"},
+      {"ply\nelement vertex 1\nproperty double x\nend_header\n0\n", "no format line"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n",
+       ":4: unknown property type 'quad'"},
+      {"ply\nformat ascii 1.0\nproperty double x\nend_header\n", ":3: property before any element"},
+      {"ply\nformat ascii 1.0\nelement vertex x\nend_header\n", ":3: malformed element"},
+      {"ply\nformat ascii 1.0\nwhatever\nend_header\n", ":3: unknown header keyword"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nend_header\n1\n",
+       "no x, y and z"},
+      {head + "1 2 3\n", ":9: line ends before x"},
+      {head + "1 2 3\n4 5\n", ":9: line ends before z"},
+      {head + "1 2 3\n4 5 6 7\n", ":9: more values"},
+      {head + "1 2 3\n4 x 6\n", ":9: 'x' is not a number"},
+      {head + "1 2 3\nnan 5 6\n", ":9: vertex 1 has a non-finite coordinate"},
+      {head + "1 2 3\n4 5 6\n7 8 9\n", "data after the last element"},
+      {"ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty double x\nproperty double y\n"
+       "property double z\nend_header\n0 0 0\n",
+       "declares 99999999999 entries"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+       "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+       "0 0 0\n3 0 1 2\n",
+       ":11: face 0 refers to vertex 1 of 1"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+       "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+       "0 0 0\n1 0 0\n0 1 0\n2 0 1\n",
+       "fewer than 3 vertices"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty uchar x\nproperty double y\n"
+       "property double z\nend_header\n1.5 0 0\n",
+       ":8: '1.5' is not an integer"},
+      {std::string("ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty double x\n"
+                   "property double y\nproperty double z\nend_header\n") +
+           std::string(20, '\0'),
+       "too short"},
+      {std::string("ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+                   "property float y\nproperty float z\nend_header\n") +
+           std::string(13, '\0'),
+       "data after the last element"},
+  };
+  for (const auto& [text, message] : bad) {
+    INFO(text);
+    CHECK_THROWS_WITH(tio::parse_ply(text), Contains(message));
+  }
+  CHECK_THROWS_WITH(tio::read_ply("/nonexistent/x.ply"), Contains("cannot open"));
+  taxel::PointCloud<double> nan_cloud;
+  nan_cloud.points.emplace_back(std::nan(""), 0.0, 0.0);
+  CHECK_THROWS_AS(tio::encode_ply(nan_cloud), std::invalid_argument);
 }
