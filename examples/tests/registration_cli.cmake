@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: MIT
+# Command-line contract of taxel-icp and taxel-recognize on the clouds and models that
+# 03_icp_align and 04_recognize_objects write: alignment recovers the pose, recognition names the
+# object, bad input gives a one-line error and a non-zero exit.
+include(${CMAKE_CURRENT_LIST_DIR}/cli_common.cmake)
+
+run_tool("${ALIGN}" 0 --quick --out align)
+expect("${out}" "point-to-plane +ok")
+run_tool("${RECOGNIZE_EXAMPLE}" 0 --quick --out rec)
+expect("${out}" "top-1 [0-9]+ / 7")
+
+run_tool("${ICP}" 0 --help)
+expect("${out}" "usage: taxel-icp")
+# The cloud in its sensor frame against the model: the printed transform maps it onto the box,
+# so aligning its output again changes nothing.
+run_tool("${ICP}" 0 --max-distance 0.05 --max-iterations 200 -o aligned.ply align/cloud_start.ply
+         align/model.ply)
+expect("${out}" "^[-0-9.e]+ [-0-9.e]+ [-0-9.e]+ [-0-9.e]+\n")
+expect("${out}" "\n0 0 0 1\nrmse 0\\.00[0-2][0-9]*\nfitness 1\\.0+\niterations [0-9]+\nstatus ok")
+run_tool("${ICP}" 0 --method point-to-point --kernel huber --kernel-scale 0.001 aligned.ply
+         align/model.ply)
+expect("${out}" "^(1|0\\.99[0-9]*) [-0-9.e]+ [-0-9.e]+ [-0-9.e]+\n")  # near identity
+expect("${out}" "status (ok|not_converged)")
+run_tool("${ICP}" 0 --init "1 0 0 0.001 0 1 0 0 0 0 1 0 0 0 0 1" aligned.ply align/model.ply)
+expect("${out}" "status ok")
+
+run_tool("${ICP}" 2 --method sideways a.ply b.ply)
+expect("${err}" "--method must be")
+run_tool("${ICP}" 2 --init "1 2 3" a.ply b.ply)
+expect("${err}" "--init needs 16 numbers, got 3")
+run_tool("${ICP}" 2 --trim 1.5 aligned.ply align/model.ply)
+expect("${err}" "trim_fraction")
+run_tool("${ICP}" 2 only-one.ply)
+expect("${err}" "expected SOURCE.ply and TARGET.ply")
+file(WRITE "${WORK_DIR}/broken.ply" "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+     "property float y\nproperty float z\nend_header\n0 0 0\n1 1\n")
+run_tool("${ICP}" 1 broken.ply align/model.ply)
+expect("${err}" "broken.ply:9: line ends before z")
+expect_one_line("${err}")
+run_tool("${ICP}" 1 missing.ply align/model.ply)
+expect("${err}" "cannot open")
+
+run_tool("${RECOGNIZE}" 0 rec/clouds/cube-50.ply rec/models)
+expect("${out}" "^rank +model")
+expect("${out}" "\n1 +cube-50 ")
+expect("${out}" "best: cube-50 \\(margin [0-9.]+ mm\\)")
+run_tool("${RECOGNIZE}" 0 --format json rec/clouds/sphere-25.ply rec/models/sphere-25.ply
+         rec/models/sphere-40.ply rec/models/cylinder-20x60.ply)
+expect("${out}" "\"best\": \"sphere-25\"")
+run_tool("${RECOGNIZE}" 0 --unknown 0.0001 rec/clouds/cube-50.ply rec/models)
+expect("${out}" "best: unknown")
+run_tool("${RECOGNIZE}" 2 --starts 40 rec/clouds/cube-50.ply rec/models)
+expect("${err}" "rotation_starts")
+run_tool("${RECOGNIZE}" 1 broken.ply rec/models)
+expect("${err}" "broken.ply:9")
+expect_one_line("${err}")
+file(MAKE_DIRECTORY "${WORK_DIR}/empty")
+run_tool("${RECOGNIZE}" 1 rec/clouds/cube-50.ply empty)
+expect("${err}" "no .ply files")
