@@ -73,9 +73,11 @@ IcpConfig bench_config() {
   return cfg;
 }
 
+// field_first: a whole alignment on the closest-point field, then an exact one from there.
+// coarse: IcpConfig::coarse_points = 500 (a subsample on the field first, then all points).
 template <class Error>
 void run_icp(benchmark::State& state, std::size_t model_points, std::size_t cloud_points,
-             bool field_first) {
+             bool field_first, bool coarse = false) {
   const Target<double> target(
       sim::sample_surface(sim::Box(Vec3d(0.04, 0.03, 0.02)), model_points, 1),
       TargetConfig{.field_cell = field_first ? 2e-3 : 0.0});
@@ -83,7 +85,9 @@ void run_icp(benchmark::State& state, std::size_t model_points, std::size_t clou
   IcpConfig approx_cfg = bench_config();
   approx_cfg.approximate = true;
   Icp<Error> approx(approx_cfg);
-  Icp<Error> exact(bench_config());
+  IcpConfig exact_cfg = bench_config();
+  if (coarse) exact_cfg.coarse_points = 500;
+  Icp<Error> exact(exact_cfg);
   std::size_t k = 0;
   double iterations = 0.0, error = 0.0, success = 0.0, runs = 0.0;
   for (auto _ : state) {
@@ -115,6 +119,15 @@ void BM_PointToPlane_2k_vs_10k(benchmark::State& s) {
 void BM_PointToPlane_2k_vs_10k_field(benchmark::State& s) {
   run_icp<PointToPlane>(s, 10000, 2000, true);
 }
+void BM_PointToPlane_2k_vs_10k_coarse(benchmark::State& s) {
+  run_icp<PointToPlane>(s, 10000, 2000, false, true);
+}
+void BM_PointToPoint_2k_vs_10k_coarse(benchmark::State& s) {
+  run_icp<PointToPoint>(s, 10000, 2000, false, true);
+}
+void BM_PointToPlane_5k_vs_50k_coarse(benchmark::State& s) {
+  run_icp<PointToPlane>(s, 50000, 5000, false, true);
+}
 void BM_PointToPoint_2k_vs_10k(benchmark::State& s) {
   run_icp<PointToPoint>(s, 10000, 2000, false);
 }
@@ -130,11 +143,14 @@ void BM_PointToPlane_5k_vs_50k_field(benchmark::State& s) {
 }
 BENCHMARK(BM_PointToPlane_2k_vs_10k)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPlane_2k_vs_10k_field)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointToPlane_2k_vs_10k_coarse)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPoint_2k_vs_10k)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointToPoint_2k_vs_10k_coarse)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPoint_2k_vs_10k_field)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPlane_500_vs_2k)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPlane_5k_vs_50k)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPlane_5k_vs_50k_field)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointToPlane_5k_vs_50k_coarse)->Unit(benchmark::kMillisecond);
 
 // Target preparation (grid, kd-tree, PCA normals, closest-point field): paid once per model.
 void BM_TargetBuild_10k(benchmark::State& state) {

@@ -26,6 +26,8 @@
 #include <taxel/sim/palm_grasp.hpp>
 #include <vector>
 
+#include "cli.hpp"
+
 #if defined(TAXEL_EXAMPLES_HAVE_PNG)
 #include <taxel/io/png.hpp>
 #endif
@@ -60,46 +62,32 @@ struct Options {
 
 [[noreturn]] void die(const std::string& why) {
   std::fprintf(stderr, "06_recognition_study: %s\n", why.c_str());
-  std::exit(2);
-}
-
-template <class T>
-T number(std::string_view flag, std::string_view text, T lo, T hi) {
-  T v{};
-  const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (res.ec != std::errc() || res.ptr != text.data() + text.size() || v < lo || v > hi) {
-    die(std::string(flag) + ": '" + std::string(text) + "' is not a number in [" +
-        std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  }
-  return v;
+  std::exit(1);
 }
 
 Options parse(int argc, char** argv) {
+  taxel_cli::Args args("06_recognition_study", argc, argv);
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string_view {
-      if (i + 1 >= argc) die(std::string(a) + " needs a value");
-      return argv[++i];
-    };
+  std::string_view a;
+  while (args.next(a)) {
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       std::exit(0);
     } else if (a == "--subjects") {
-      o.subjects = number<int>(a, value(), 2, 1000);
+      o.subjects = args.number<int>(2, 1000);
     } else if (a == "--grasps") {
-      o.grasps = number<int>(a, value(), 1, 1000);
+      o.grasps = args.number<int>(1, 1000);
     } else if (a == "--seed") {
-      o.seed = number<std::uint64_t>(a, value(), 0, std::numeric_limits<std::uint64_t>::max());
+      o.seed = args.number<std::uint64_t>(0, std::numeric_limits<std::uint64_t>::max());
     } else if (a == "--out") {
-      o.out = std::string(value());
+      o.out = std::string(args.value());
     } else if (a == "--quick") {
       o.subjects = 5;
     } else {
-      die("unknown argument '" + std::string(a) + "' (see --help)");
+      args.fail("unknown argument '" + std::string(a) + "' (see --help)");
     }
   }
-  if (o.subjects * o.grasps * 8 < 40) die("too few images for 5-fold cross-validation");
+  if (o.subjects * o.grasps * 8 < 40) args.fail("too few images for 5-fold cross-validation");
   return o;
 }
 

@@ -5,12 +5,15 @@
 #include <charconv>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <taxel/image.hpp>
 #include <taxel/io.hpp>
 #include <taxel/learn/dataset.hpp>
 #include <vector>
+
+#include "cli.hpp"
 
 namespace {
 
@@ -58,24 +61,12 @@ struct Options {
   std::exit(2);
 }
 
-template <class T>
-T number(std::string_view flag, std::string_view text) {
-  T v{};
-  const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (res.ec != std::errc() || res.ptr != text.data() + text.size()) {
-    die(std::string(flag) + ": '" + std::string(text) + "' is not a valid number");
-  }
-  return v;
-}
-
 Options parse(int argc, char** argv) {
+  taxel_cli::Args args("taxel-describe", argc, argv);
+  const auto value = [&] { return args.value(); };
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string_view {
-      if (i + 1 >= argc) die(std::string(a) + " needs a value");
-      return argv[++i];
-    };
+  std::string_view a;
+  while (args.next(a)) {
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       std::exit(0);
@@ -94,13 +85,17 @@ Options parse(int argc, char** argv) {
       o.cfg.segmentation.polarity =
           v == "high" ? ti::Polarity::high_is_pressure : ti::Polarity::dark_is_pressure;
     } else if (a == "--k") {
-      o.cfg.segmentation.k = number<int>(a, value());
+      o.cfg.segmentation.k =
+          args.number<int>(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
     } else if (a == "--min-area") {
-      o.cfg.segmentation.min_area = number<int>(a, value());
+      o.cfg.segmentation.min_area =
+          args.number<int>(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
     } else if (a == "--threshold") {
-      o.threshold = number<double>(a, value());
+      o.threshold = args.number<double>(-std::numeric_limits<double>::infinity(),
+                                        std::numeric_limits<double>::infinity());
     } else if (a == "--degree") {
-      o.cfg.edgeless.degree = number<int>(a, value());
+      o.cfg.edgeless.degree =
+          args.number<int>(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
     } else if (a == "-o") {
       o.output = std::string(value());
     } else if (a.size() > 1 && a[0] == '-') {
@@ -119,19 +114,6 @@ std::string fmt(double v) {
   char buf[32];
   const auto res = std::to_chars(buf, buf + sizeof buf, v);
   return {buf, res.ptr};
-}
-
-std::string json_escape(std::string_view s) {
-  std::string out;
-  for (const char ch : s) {
-    if (ch == '"' || ch == '\\') out.push_back('\\');
-    if (static_cast<unsigned char>(ch) < 0x20) {
-      out += ' ';
-      continue;
-    }
-    out.push_back(ch);
-  }
-  return out;
 }
 
 constexpr const char* kExtra[] = {"MajorAxisLength", "MinorAxisLength", "Solidity", "Extent",
@@ -241,9 +223,9 @@ int main(int argc, char** argv) try {
       }
       std::string obj = first ? "  {" : ",\n  {";
       first = false;
-      obj += "\"file\": \"" + json_escape(path) + "\", \"frame\": " + std::to_string(f) +
+      obj += "\"file\": \"" + taxel_cli::json_escape(path) + "\", \"frame\": " + std::to_string(f) +
              ", \"status\": \"" + status + "\"";
-      if (!r.ok()) obj += ", \"message\": \"" + json_escape(r.message) + "\"";
+      if (!r.ok()) obj += ", \"message\": \"" + taxel_cli::json_escape(r.message) + "\"";
       obj += std::string(", \"edged\": ") + (r.edged ? "true" : "false") +
              ", \"Gm\": " + fmt(r.contour_gradient) + ", \"features\": {";
       for (std::size_t i = 0; i < ti::kEdgeFeatureNames.size(); ++i) {

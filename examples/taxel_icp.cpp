@@ -11,6 +11,8 @@
 #include <taxel/registration.hpp>
 #include <vector>
 
+#include "cli.hpp"
+
 namespace {
 
 namespace tr = taxel::registration;
@@ -39,16 +41,12 @@ options:
 Exit status: 0 when ICP ran (whatever its status), 1 for unreadable input, 2 for bad options.
 )usage";
 
-[[noreturn]] void die(const std::string& why, int code = 2) {
-  std::fprintf(stderr, "taxel-icp: %s\n", why.c_str());
-  std::exit(code);
-}
-
-double number(std::string_view flag, std::string_view text) {
+// Parses a number the way every option does (taxel_cli::Args::number), from a token.
+double number(const taxel_cli::Args& args, std::string_view flag, std::string_view text) {
   double v = 0.0;
   const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
   if (res.ec != std::errc() || res.ptr != text.data() + text.size()) {
-    die(std::string(flag) + ": '" + std::string(text) + "' is not a number");
+    args.fail(std::string(flag) + ": '" + std::string(text) + "' is not a number");
   }
   return v;
 }
@@ -64,70 +62,62 @@ struct Options {
   std::vector<std::string> inputs;
 };
 
-Options parse(int argc, char** argv) {
+Options parse(taxel_cli::Args& args) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string_view {
-      if (i + 1 >= argc) die(std::string(a) + " needs a value");
-      return argv[++i];
-    };
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::string_view a;
+  while (args.next(a)) {
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       std::exit(0);
     } else if (a == "--method") {
-      const auto v = value();
+      const auto v = args.value();
       if (v != "point-to-plane" && v != "point-to-point") {
-        die("--method must be point-to-plane or point-to-point");
+        args.fail("--method must be point-to-plane or point-to-point");
       }
       o.point_to_point = v == "point-to-point";
     } else if (a == "--kernel") {
-      o.kernel = std::string(value());
+      o.kernel = std::string(args.value());
       if (o.kernel != "none" && o.kernel != "huber" && o.kernel != "cauchy" &&
           o.kernel != "geman-mcclure" && o.kernel != "tukey") {
-        die("--kernel must be none, huber, cauchy, geman-mcclure or tukey");
+        args.fail("--kernel must be none, huber, cauchy, geman-mcclure or tukey");
       }
     } else if (a == "--kernel-scale") {
-      o.kernel_scale = number(a, value());
-      if (!(o.kernel_scale > 0)) die("--kernel-scale must be > 0");
+      o.kernel_scale = args.number<double>(1e-300, kInf);
     } else if (a == "--max-distance") {
-      o.icp.max_distance = number(a, value());
+      o.icp.max_distance = args.number<double>(-kInf, kInf);
     } else if (a == "--trim") {
-      o.icp.trim_fraction = number(a, value());
+      o.icp.trim_fraction = args.number<double>(-kInf, kInf);
     } else if (a == "--max-iterations") {
-      const double n = number(a, value());
-      if (n != static_cast<int>(n)) die("--max-iterations must be an integer");
-      o.icp.max_iterations = static_cast<int>(n);
+      o.icp.max_iterations = args.number<int>(1, 1000000);
     } else if (a == "--tolerance") {
-      o.icp.translation_tolerance = o.icp.rotation_tolerance = number(a, value());
+      o.icp.translation_tolerance = o.icp.rotation_tolerance = args.number<double>(0.0, kInf);
     } else if (a == "--init") {
-      const std::string_view v = value();
+      const std::string_view v = args.value();
       std::vector<double> m;
       std::size_t p = 0;
       while (p < v.size()) {
         while (p < v.size() && (v[p] == ' ' || v[p] == ',' || v[p] == '\t')) ++p;
         std::size_t e = p;
         while (e < v.size() && v[e] != ' ' && v[e] != ',' && v[e] != '\t') ++e;
-        if (e > p) m.push_back(number(a, v.substr(p, e - p)));
+        if (e > p) m.push_back(number(args, a, v.substr(p, e - p)));
         p = e;
       }
-      if (m.size() != 16) die("--init needs 16 numbers, got " + std::to_string(m.size()));
+      if (m.size() != 16) args.fail("--init needs 16 numbers, got " + std::to_string(m.size()));
       Eigen::Matrix4d t;
       for (int k = 0; k < 16; ++k) t(k / 4, k % 4) = m[static_cast<std::size_t>(k)];
       o.init.matrix() = t;
     } else if (a == "--normal-neighbors") {
-      const double n = number(a, value());
-      if (n != static_cast<int>(n)) die("--normal-neighbors must be an integer");
-      o.normal_neighbors = static_cast<int>(n);
+      o.normal_neighbors = args.number<int>(3, 1000);
     } else if (a == "-o") {
-      o.output = std::string(value());
+      o.output = std::string(args.value());
     } else if (a.size() > 1 && a[0] == '-') {
-      die("unknown option '" + std::string(a) + "' (see --help)");
+      args.fail("unknown option '" + std::string(a) + "' (see --help)");
     } else {
       o.inputs.emplace_back(a);
     }
   }
-  if (o.inputs.size() != 2) die("expected SOURCE.ply and TARGET.ply (see --help)");
+  if (o.inputs.size() != 2) args.fail("expected SOURCE.ply and TARGET.ply (see --help)");
   return o;
 }
 
@@ -152,13 +142,14 @@ tr::IcpResult dispatch(const Options& o, const tr::Target<double>& target,
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options opt = parse(argc, argv);
+  taxel_cli::Args args("taxel-icp", argc, argv);
+  const Options opt = parse(args);
   taxel::io::PlyData source, target;
   try {
     source = taxel::io::read_ply(opt.inputs[0]);
     target = taxel::io::read_ply(opt.inputs[1]);
   } catch (const std::exception& e) {
-    die(e.what(), 1);
+    args.fail(e.what(), 1);
   }
   tr::IcpResult r;
   try {
@@ -167,7 +158,7 @@ int main(int argc, char** argv) {
     r = opt.point_to_point ? dispatch<tr::PointToPoint>(opt, tg, source.cloud)
                            : dispatch<tr::PointToPlane>(opt, tg, source.cloud);
   } catch (const std::invalid_argument& e) {  // a configuration Icp or Target refuses
-    die(e.what());
+    args.fail(e.what());
   }
   for (int row = 0; row < 4; ++row) {
     std::printf("%.17g %.17g %.17g %.17g\n", r.transform(row, 0), r.transform(row, 1),
@@ -183,7 +174,7 @@ int main(int argc, char** argv) {
     try {
       taxel::io::write_ply(opt.output, taxel::transformed(source.cloud, r.transform));
     } catch (const std::exception& e) {
-      die(e.what(), 1);
+      args.fail(e.what(), 1);
     }
   }
   return 0;

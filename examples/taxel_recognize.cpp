@@ -6,11 +6,14 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <taxel/io/ply.hpp>
 #include <taxel/registration.hpp>
 #include <vector>
+
+#include "cli.hpp"
 
 namespace {
 
@@ -35,54 +38,28 @@ options:
 Exit status: 0 when the cloud was ranked, 1 for unreadable input, 2 for bad options.
 )usage";
 
-[[noreturn]] void die(const std::string& why, int code = 2) {
-  std::fprintf(stderr, "taxel-recognize: %s\n", why.c_str());
-  std::exit(code);
-}
-
-double number(std::string_view flag, std::string_view text) {
-  double v = 0.0;
-  const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (res.ec != std::errc() || res.ptr != text.data() + text.size()) {
-    die(std::string(flag) + ": '" + std::string(text) + "' is not a number");
-  }
-  return v;
-}
-
-std::string json_escape(std::string_view s) {
-  std::string out;
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out.push_back('\\');
-    out.push_back(static_cast<unsigned char>(c) < 0x20 ? ' ' : c);
-  }
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::Args args("taxel-recognize", argc, argv);
+  const auto die = [&](const std::string& why, int code = 2) { args.fail(why, code); };
+  constexpr double kInf = std::numeric_limits<double>::infinity();
   tr::LibraryConfig cfg;
   bool json = false;
   std::vector<std::string> inputs;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string_view {
-      if (i + 1 >= argc) die(std::string(a) + " needs a value");
-      return argv[++i];
-    };
+  std::string_view a;
+  while (args.next(a)) {
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       return 0;
     } else if (a == "--unknown") {
-      cfg.unknown_score = number(a, value());
+      cfg.unknown_score = args.number<double>(-kInf, kInf);
     } else if (a == "--gate") {
-      cfg.score_gate = number(a, value());
+      cfg.score_gate = args.number<double>(-kInf, kInf);
     } else if (a == "--starts") {
-      const double n = number(a, value());
-      if (n != static_cast<int>(n)) die("--starts must be an integer");
-      cfg.rotation_starts = static_cast<int>(n);
+      cfg.rotation_starts = args.number<int>(-1000, 1000);
     } else if (a == "--format") {
-      const auto v = value();
+      const auto v = args.value();
       if (v != "text" && v != "json") die("--format must be text or json");
       json = v == "json";
     } else if (a.size() > 1 && a[0] == '-') {
@@ -124,11 +101,12 @@ int main(int argc, char** argv) {
 
   if (json) {
     std::printf("{\"best\": \"%s\", \"unknown\": %s, \"margin\": %.9g, \"ranking\": [",
-                json_escape(r.best).c_str(), r.unknown ? "true" : "false", r.margin);
+                taxel_cli::json_escape(r.best).c_str(), r.unknown ? "true" : "false", r.margin);
     for (std::size_t k = 0; k < r.ranking.size(); ++k) {
       const auto& m = r.ranking[k];
       std::printf("%s\n  {\"model\": \"%s\", \"score\": %.9g, \"rmse\": %.9g, \"fitness\": %.6f}",
-                  k ? "," : "", json_escape(m.name).c_str(), m.score, m.rmse, m.inlier_fraction);
+                  k ? "," : "", taxel_cli::json_escape(m.name).c_str(), m.score, m.rmse,
+                  m.inlier_fraction);
     }
     std::printf("\n]}\n");
     return 0;

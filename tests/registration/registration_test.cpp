@@ -174,6 +174,16 @@ TEST_CASE(
   // A start from the truth converges at once.
   const IcpResult c = p2l.align(tg, std::span<const Vec3d>(source), truth);
   CHECK(c.iterations <= 2);
+  // Coarse-to-fine (a subsample on the closest-point field first) ends exactly as well.
+  const Target<double> with_field(model, TargetConfig{.field_cell = 1e-3});
+  IcpConfig coarse_cfg = tight();
+  coarse_cfg.coarse_points = 200;
+  const IcpResult d =
+      Icp<PointToPlane>(coarse_cfg).align(with_field, std::span<const Vec3d>(source));
+  INFO(d.message);
+  CHECK(d.status == Status::ok);
+  CHECK(rotation_error(d.transform, truth) < 1e-9);
+  CHECK((d.transform.translation() - truth.translation()).norm() < 1e-9);
 }
 
 TEST_CASE("ICP with noise: the pose error is within the statistical bound", "[registration][icp]") {

@@ -48,6 +48,11 @@ struct IcpConfig {
   /// lookup, off by up to half a field cell diagonal) and search exactly elsewhere. For coarse
   /// stages; the final iterations of an accurate alignment should be exact.
   bool approximate = false;
+  /// When > 0 and the source has at least twice as many points: first align an evenly spaced
+  /// subsample of this many points (on the target's closest-point field when it has one, with
+  /// tolerances ten times looser), then the whole source, exactly, from there. Iterations
+  /// count both stages. 0: off.
+  std::size_t coarse_points = 0;
 };
 
 /// The outcome of one alignment. `ok`: converged; `not_converged`: the iteration cap was hit
@@ -278,50 +283,24 @@ class Icp {
     scratch_.reserve(src_.size());
 
     Isometry3d t = initial;
-    double previous_rmse = std::numeric_limits<double>::infinity();
-    Outcome last{};
-    bool converged = false;
-    for (int it = 0; it < cfg_.max_iterations; ++it) {
-      const double rmse = correspond(target, t);
-      if (pairs_.size() < need) {
-        return finish(res, target, t, Status::degenerate,
-                      std::to_string(pairs_.size()) + " correspondences within max_distance; " +
-                          std::string(Error::name) + " needs at least " + std::to_string(need));
+    int iterations = 0;
+    // Coarse stage: an evenly spaced subsample, on the closest-point field when the target has
+    // one, with tolerances ten times looser; its result starts the full alignment.
+    if (cfg_.coarse_points > 0 && src_.size() >= 2 * cfg_.coarse_points &&
+        cfg_.coarse_points >= need) {
+      coarse_.clear();
+      for (std::size_t i = 0; i < cfg_.coarse_points; ++i) {
+        coarse_.push_back(src_[i * src_.size() / cfg_.coarse_points]);
       }
-      if (cfg_.relative_error_tolerance > 0.0 &&
-          std::fabs(previous_rmse - rmse) <= cfg_.relative_error_tolerance * rmse) {
-        converged = true;
-        break;
-      }
-      previous_rmse = rmse;
-      Isometry3d delta;
-      last = Error::solve(pairs_, delta);
-      if (!delta.matrix().allFinite()) {
-        return finish(res, target, t, Status::degenerate, "the update is not finite");
-      }
-      if (last.status == Status::degenerate && Error::min_correspondences == 3) {
-        return finish(res, target, t, Status::degenerate, last.message);  // nothing to apply
-      }
-      t = delta * t;
-      // Re-orthonormalise against drift over many updates.
-      t.linear() = Eigen::Quaterniond(t.linear()).normalized().toRotationMatrix();
-      ++res.iterations;
-      const double angle = Eigen::AngleAxisd(delta.linear()).angle();
-      if (delta.translation().norm() <= cfg_.translation_tolerance &&
-          angle <= cfg_.rotation_tolerance) {
-        converged = true;
-        break;
-      }
+      active_ = &coarse_;
+      approximate_ = cfg_.approximate || target.has_field();
+      (void)iterate(target, t, need, 10.0, iterations);
     }
-    if (last.status == Status::degenerate) {
-      return finish(res, target, t, Status::degenerate, last.message);
-    }
-    if (!converged) {
-      return finish(res, target, t, Status::not_converged,
-                    "reached max_iterations = " + std::to_string(cfg_.max_iterations) +
-                        " before the update fell below the tolerances");
-    }
-    return finish(res, target, t, Status::ok, {});
+    active_ = &src_;
+    approximate_ = cfg_.approximate;
+    const Outcome end = iterate(target, t, need, 1.0, iterations);
+    res.iterations = iterations;
+    return finish(res, target, t, end.status, end.message);
   }
 
   /// Aligns the points of `source`.
@@ -335,6 +314,48 @@ class Icp {
   [[nodiscard]] const Kernel& kernel() const noexcept { return kernel_; }
 
  private:
+  // Iterates from t (updated in place) on *active_ until converged (ok), the cap
+  // (not_converged) or too few pairs (degenerate); a degenerate last solve makes the result
+  // degenerate. `iterations` counts the updates applied.
+  template <Scalar S>
+  Outcome iterate(const Target<S>& target, Isometry3d& t, std::size_t need, double loosen,
+                  int& iterations) {
+    double previous_rmse = std::numeric_limits<double>::infinity();
+    Outcome last{};
+    for (int it = 0; it < cfg_.max_iterations; ++it) {
+      const double rmse = correspond(target, t);
+      if (pairs_.size() < need) {
+        return {Status::degenerate,
+                std::to_string(pairs_.size()) + " correspondences within max_distance; " +
+                    std::string(Error::name) + " needs at least " + std::to_string(need)};
+      }
+      if (cfg_.relative_error_tolerance > 0.0 &&
+          std::fabs(previous_rmse - rmse) <= loosen * cfg_.relative_error_tolerance * rmse) {
+        return last;
+      }
+      previous_rmse = rmse;
+      Isometry3d delta;
+      last = Error::solve(pairs_, delta);
+      if (!delta.matrix().allFinite()) return {Status::degenerate, "the update is not finite"};
+      if (last.status == Status::degenerate && Error::min_correspondences == 3) {
+        return last;  // nothing to apply
+      }
+      t = delta * t;
+      // Re-orthonormalise against drift over many updates.
+      t.linear() = Eigen::Quaterniond(t.linear()).normalized().toRotationMatrix();
+      ++iterations;
+      const double angle = Eigen::AngleAxisd(delta.linear()).angle();
+      if (delta.translation().norm() <= loosen * cfg_.translation_tolerance &&
+          angle <= loosen * cfg_.rotation_tolerance) {
+        return last;
+      }
+    }
+    if (last.status == Status::degenerate) return last;
+    return {Status::not_converged,
+            "reached max_iterations = " + std::to_string(cfg_.max_iterations) +
+                " before the update fell below the tolerances"};
+  }
+
   // Fills pairs_ at transform t (gate, trimming, kernel weights); returns the inlier RMSE.
   template <Scalar S>
   double correspond(const Target<S>& target, const Isometry3d& t) {
@@ -343,11 +364,11 @@ class Icp {
     const auto& nrm = target.normals();
     const S gate = static_cast<S>(std::min(cfg_.max_distance, 1e300));
     const double gate2 = cfg_.max_distance * cfg_.max_distance;
-    for (const Vec3d& s : src_) {
+    for (const Vec3d& s : *active_) {
       const Vec3d p = t * s;
       const Vec3<S> ps = p.template cast<S>();
       index::PointId id = 0;
-      if (const auto approx = cfg_.approximate ? target.field_nearest(ps) : std::nullopt) {
+      if (const auto approx = approximate_ ? target.field_nearest(ps) : std::nullopt) {
         id = *approx;
       } else if (const auto nb = target.nearest_within(ps, gate)) {
         id = nb->id;
@@ -402,6 +423,9 @@ class Icp {
   IcpConfig cfg_;
   Kernel kernel_;
   std::vector<Vec3d> src_;
+  std::vector<Vec3d> coarse_;
+  const std::vector<Vec3d>* active_ = &src_;
+  bool approximate_ = false;
   std::vector<Correspondence> pairs_;
   std::vector<double> scratch_;
 };

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+// Shared command-line plumbing of the example tools: one-line errors with the tool's name and
+// an exit code, option values, strictly parsed numbers, JSON string escaping.
+#pragma once
+
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+namespace taxel_cli {
+
+/// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).
+class Args {
+ public:
+  Args(const char* tool, int argc, char** argv) : tool_(tool), argc_(argc), argv_(argv) {}
+
+  /// The next argument, or false at the end.
+  bool next(std::string_view& arg) {
+    if (i_ + 1 >= argc_) return false;
+    arg = current_ = argv_[++i_];
+    return true;
+  }
+
+  /// The value of the current option (the next argument); fails when there is none.
+  std::string_view value() {
+    if (i_ + 1 >= argc_) fail(std::string(current_) + " needs a value");
+    return argv_[++i_];
+  }
+
+  /// The current option's value as a number of type T in [lo, hi].
+  template <class T>
+  T number(T lo, T hi) {
+    const std::string_view text = value();
+    T v{};
+    const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (res.ec != std::errc() || res.ptr != text.data() + text.size() || !(v >= lo && v <= hi)) {
+      fail(std::string(current_) + ": '" + std::string(text) + "' is not a number in [" +
+           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
+    return v;
+  }
+
+  /// Prints "<tool>: <why>" and exits with `code`.
+  [[noreturn]] void fail(const std::string& why, int code = 2) const {
+    std::fprintf(stderr, "%s: %s\n", tool_, why.c_str());
+    std::exit(code);
+  }
+
+ private:
+  const char* tool_;
+  int argc_;
+  char** argv_;
+  int i_ = 0;
+  std::string_view current_;
+};
+
+/// `s` with quotes and backslashes escaped and control characters blanked, for JSON strings.
+inline std::string json_escape(std::string_view s) {
+  std::string out;
+  out.reserve(s.size());
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out.push_back('\\');
+    out.push_back(static_cast<unsigned char>(c) < 0x20 ? ' ' : c);
+  }
+  return out;
+}
+
+}  // namespace taxel_cli
