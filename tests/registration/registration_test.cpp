@@ -460,3 +460,27 @@ TEST_CASE("ObjectLibrary recognises partial, noisy, randomly posed clouds",
   CHECK_THROWS_WITH(ObjectLibrary<double>(LibraryConfig{.rotation_starts = 30}),
                     Contains("rotation_starts"));
 }
+
+TEST_CASE("Registration works on float clouds", "[registration][icp]") {
+  const PointCloud<double> model = asymmetric(4000, 12);
+  PointCloud<float> mf;
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    mf.points.push_back(model.points[i].cast<float>());
+    mf.normals.push_back(model.normals[i].cast<float>());
+  }
+  const Target<float> tg(mf, TargetConfig{.field_cell = 2e-3});
+  const Isometry3d truth = pose(0.1, Vec3d(0, 1, 0), Vec3d(0.002, 0.001, 0.0));
+  std::vector<Vec3f> source;
+  for (std::size_t i = 0; i < model.size(); i += 4)
+    source.push_back((truth.inverse() * model.points[i]).cast<float>());
+  const IcpResult r =
+      Icp<PointToPlane>(IcpConfig{.coarse_points = 300}).align(tg, std::span<const Vec3f>(source));
+  CHECK(r.ok());
+  CHECK(rotation_error(r.transform, truth) < 1e-5);
+  CHECK((r.transform.translation() - truth.translation()).norm() < 1e-5);
+  ObjectLibrary<float> lib;
+  lib.add("object", mf);
+  PointCloud<float> cloud;
+  cloud.points = source;
+  CHECK(lib.recognize(cloud).best == "object");
+}
