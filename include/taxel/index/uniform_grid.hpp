@@ -31,10 +31,14 @@ class UniformGrid {
   using Scalar = S;
   /// Build parameters.
   struct Config {
-    /// Cell edge [m]; 0 picks about twice the mean nearest-neighbour spacing of the points.
+    /// Cell edge [m]; 0 picks `spacing_factor` times the points' mean nearest-neighbour
+    /// spacing.
     S cell = S(0);
     /// Largest number of cells; the cell grows until the grid fits, >= 1.
     std::size_t max_cells = std::size_t{1} << 24;
+    /// The automatic cell in mean spacings, > 0. Larger cells hold more points but answer
+    /// more queries from the 2 x 2 x 2 block: make them larger than typical query distances.
+    double spacing_factor = 2.0;
   };
 
   /// Builds the grid. Throws std::invalid_argument for non-finite points, a negative or
@@ -62,7 +66,11 @@ class UniformGrid {
       hi = hi.cwiseMax(p);
     }
     const Vec3<S> extent = hi - lo_;
-    double cell = config.cell > S(0) ? static_cast<double>(config.cell) : default_cell();
+    if (!(config.spacing_factor > 0.0) || !std::isfinite(config.spacing_factor)) {
+      throw std::invalid_argument("UniformGrid::Config: spacing_factor must be finite and > 0");
+    }
+    double cell = config.cell > S(0) ? static_cast<double>(config.cell)
+                                     : config.spacing_factor * mean_spacing();
     for (;;) {
       std::array<double, 3> n{};
       double total = 1.0;
@@ -169,8 +177,8 @@ class UniformGrid {
   }
 
  private:
-  // Twice the mean nearest-neighbour distance of up to 64 evenly spread points (brute force).
-  [[nodiscard]] double default_cell() const {
+  // The mean nearest-neighbour distance of up to 64 evenly spread points (brute force).
+  [[nodiscard]] double mean_spacing() const {
     const std::size_t n = points_.size();
     const std::size_t samples = std::min<std::size_t>(n, 64);
     double sum = 0.0;
@@ -187,7 +195,7 @@ class UniformGrid {
         ++counted;
       }
     }
-    return counted == 0 ? 1.0 : std::max(2.0 * sum / static_cast<double>(counted), 1e-9);
+    return counted == 0 ? 1.0 : std::max(sum / static_cast<double>(counted), 1e-9);
   }
 
   [[nodiscard]] Vec3<S> coord(const Vec3<S>& p) const { return (p - lo_) * inv_cell_; }

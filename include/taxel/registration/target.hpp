@@ -29,6 +29,10 @@ struct TargetConfig {
   int normal_neighbors = 12;
   /// Estimate normals even when the cloud has them.
   bool recompute_normals = false;
+  /// Cell of the nearest-neighbour grid in mean point spacings (UniformGrid::Config): cells
+  /// larger than the typical distance of a cloud point to the model answer most queries from
+  /// 8 cells.
+  double grid_spacing_factor = 4.0;
   /// Closest-point field for approximate correspondences (IcpConfig::approximate): cell edge
   /// [m] (0: none) and margin around the points' bounding box [m]. Each cell stores the exact
   /// nearest point to its centre, so a lookup errs by at most half a cell diagonal.
@@ -45,7 +49,8 @@ class Target {
   /// given normal is zero or the normals do not match the points, or normal_neighbors < 3.
   explicit Target(PointCloud<S> cloud, TargetConfig cfg = {})
       : grid_(checked(cloud, cfg),
-              typename index::UniformGrid<S>::Config{S(0), std::size_t{1} << 22}),
+              typename index::UniformGrid<S>::Config{S(0), std::size_t{1} << 22,
+                                                     cfg.grid_spacing_factor}),
         tree_(grid_.points()) {
     const std::vector<Vec3<S>>& pts = grid_.points();
     if (cloud.has_normals() && !cfg.recompute_normals) {
