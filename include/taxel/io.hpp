@@ -2,6 +2,7 @@
 // Umbrella header of taxel::io (without io/png.hpp, which needs libpng at link time).
 #pragma once
 
+#include "taxel/io/contacts_csv.hpp"
 #include "taxel/io/file.hpp"
 #include "taxel/io/image.hpp"
 #include "taxel/io/libsvm_format.hpp"

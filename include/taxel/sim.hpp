@@ -2,6 +2,7 @@
 // Umbrella header of taxel::sim.
 #pragma once
 
+#include "taxel/sim/metrics.hpp"
 #include "taxel/sim/palm_grasp.hpp"
 #include "taxel/sim/sampling.hpp"
 #include "taxel/sim/shapes.hpp"

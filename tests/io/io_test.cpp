@@ -277,6 +277,21 @@ TEST_CASE("PLY: ASCII and binary round trips, foreign files, strict errors", "[i
   REQUIRE(f.cloud.field("red") != nullptr);
   CHECK(f.cloud.field("red")->values[0] == 255);
   CHECK(f.triangles.size() == 2);
+  // Faces before the vertices, properties in another order, an unrelated element.
+  const std::string faces_first =
+      "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar uint vertex_indices\n"
+      "element camera 1\nproperty float focal\nelement vertex 3\nproperty float z\n"
+      "property float intensity\nproperty float x\nproperty float y\nend_header\n"
+      "3 2 1 0\n35.0\n1 0.5 0 0\n2 0.5 1 0\n3 0.5 0 1\n";
+  const tio::PlyData ff = tio::parse_ply(faces_first);
+  CHECK(ff.cloud.points[1] == taxel::Vec3d(1, 0, 2));
+  CHECK(ff.cloud.field("intensity")->values[2] == 0.5);
+  CHECK(ff.triangles == std::vector<std::array<std::uint32_t, 3>>{{2, 1, 0}});
+  CHECK_THROWS_WITH(tio::parse_ply("ply\nformat ascii 1.0\nelement face 1\nproperty list uchar "
+                                   "int vertex_indices\nelement vertex 1\nproperty float x\n"
+                                   "property float y\nproperty float z\nend_header\n3 0 1 "
+                                   "2\n0 0 0\n"),
+                    Contains("refers to vertex 1 of 1"));
   // Binary float32 written by hand.
   std::string bin =
       "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
@@ -346,4 +361,56 @@ TEST_CASE("PLY: ASCII and binary round trips, foreign files, strict errors", "[i
   taxel::PointCloud<double> nan_cloud;
   nan_cloud.points.emplace_back(std::nan(""), 0.0, 0.0);
   CHECK_THROWS_AS(tio::encode_ply(nan_cloud), std::invalid_argument);
+}
+
+TEST_CASE("Contacts CSV: round trip, foreign layouts, strict errors", "[io][csv]") {
+  namespace tio = taxel::io;
+  std::vector<taxel::Contact<double>> contacts(3);
+  contacts[0].position = {0.01, -0.02, 0.03};
+  contacts[0].time = 0.001;
+  contacts[0].covariance = taxel::pad_covariance<double>({0, 0, 1}, 1e-3, 9.8e-4);
+  contacts[0].normal = taxel::Vec3d(0, 0, 1);
+  contacts[0].pressure = 1234.5;
+  contacts[1].position = {1.0 / 3.0, 2e-9, -7.25};
+  contacts[2].position = {0, 0, 0};
+  contacts[2].normal = taxel::Vec3d(0.6, 0.8, 0);
+  const auto back = tio::parse_contacts_csv(tio::encode_contacts_csv(contacts));
+  REQUIRE(back.size() == 3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    CHECK(back[i].position == contacts[i].position);
+    CHECK(back[i].covariance == contacts[i].covariance);
+    CHECK(back[i].normal == contacts[i].normal);
+    CHECK(back[i].time == contacts[i].time);
+    CHECK(back[i].pressure == contacts[i].pressure);
+  }
+  // Only positions, reordered columns, comments, CRLF, blank lines.
+  const auto minimal = tio::parse_contacts_csv("# exported\r\nz, x ,y\r\n\r\n3,1,2\r\n6,4,5\r\n");
+  REQUIRE(minimal.size() == 2);
+  CHECK(minimal[1].position == taxel::Vec3d(4, 5, 6));
+  CHECK(minimal[1].covariance == taxel::Mat3d::Identity() * 1e-6);
+  CHECK_FALSE(minimal[0].normal);
+
+  struct Bad {
+    std::string text;
+    const char* message;
+  };
+  const std::vector<Bad> bad{
+      {"", "no header line"},
+      {"x,y,w\n", ":1: column 3: unknown column 'w'"},
+      {"x,y,z,x\n", ":1: column 4: column 'x' appears twice"},
+      {"time,x,y\n", ":1: the header needs columns x, y and z"},
+      {"x,y,z,cxx\n", ":1: covariance needs all six"},
+      {"x,y,z,nx,ny\n", ":1: the normal needs nx, ny and nz"},
+      {"x,y,z\n1,2\n", ":2: row has 2 values; the header has 3"},
+      {"x,y,z\n1,2,3\n1,2,abc\n", ":3: column 3: 'abc' is not a number"},
+      {"x,y,z\nnan,2,3\n", ":2: column 1: the position is not finite"},
+      {"x,y,z\n1,,3\n", ":2: column 2: y is empty"},
+      {"x,y,z,nx,ny,nz\n1,2,3,0,,1\n", ":2: column 4: a normal needs nx, ny and nz"},
+      {"time,x,y,z\n1e999,1,2,3\n", ":2: column 1: '1e999' is not a number"},
+  };
+  for (const auto& [text, message] : bad) {
+    INFO(text);
+    CHECK_THROWS_WITH(tio::parse_contacts_csv(text), Contains(message));
+  }
+  CHECK_THROWS_WITH(tio::read_contacts_csv("/nonexistent.csv"), Contains("cannot open"));
 }

@@ -59,3 +59,107 @@ TEST_CASE("sliding exploration is deterministic and stays on the surface within 
   CHECK(err.rms < 1.6e-3);
   CHECK(a.back().time > a.front().time);
 }
+
+TEST_CASE("Reconstruction metrics: distances, coverage, compaction", "[sim][metrics]") {
+  const taxel::sim::Sphere sphere(0.04);
+  const auto dense = taxel::sim::sample_surface(sphere, 20000, 3);
+  const auto full = taxel::sim::reconstruction_metrics(sphere, dense.points, 100000);
+  CHECK(full.error.max < 1e-12);
+  CHECK(full.coverage == 1.0);
+  CHECK(full.points == 20000);
+  CHECK(full.compaction == Approx(5.0));
+  // The upper half only, 1 mm off the surface: half covered (within the 5 mm radius, a thin
+  // band beyond the equator too), and every distance 1 mm.
+  std::vector<taxel::Vec3d> half;
+  for (const auto& p : dense.points) {
+    if (p.z() > 0) half.push_back(p * (0.041 / 0.04));
+  }
+  const auto m = taxel::sim::reconstruction_metrics(sphere, half, half.size());
+  CHECK(m.error.mean == Approx(1e-3).epsilon(1e-9));
+  CHECK(m.error.max == Approx(1e-3).epsilon(1e-9));
+  CHECK(m.coverage > 0.5);
+  CHECK(m.coverage < 0.5 + 0.1);
+  CHECK(m.compaction == 1.0);
+  const auto empty = taxel::sim::reconstruction_metrics(sphere, {}, 0);
+  CHECK(empty.coverage == 0.0);
+  CHECK(empty.compaction == 0.0);
+  CHECK_THROWS_AS(taxel::sim::reconstruction_metrics(sphere, half, 1, {.coverage_radius = 0.0}),
+                  std::invalid_argument);
+}
+
+TEST_CASE("Cone: exact closest point, signed distance, normals; uniform sampling",
+          "[sim][shapes]") {
+  const taxel::sim::Cone cone(0.03, 0.06);
+  // Dense surface samples as a brute-force oracle: no sample is nearer than the exact distance,
+  // and the nearest sample is within the sampling spacing of it.
+  const auto samples = taxel::sim::sample_surface(cone, 200000, 5);
+  for (const auto& p : samples.points) REQUIRE(std::abs(cone.signed_distance(p)) < 1e-12);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-0.06, 0.06);
+  for (int q = 0; q < 300; ++q) {
+    const taxel::Vec3d p(u(rng), u(rng), u(rng));
+    const double d = cone.signed_distance(p);
+    const taxel::Vec3d c = cone.closest_point(p);
+    REQUIRE(std::abs(cone.signed_distance(c)) < 1e-12);            // on the surface
+    REQUIRE((p - c).norm() == Approx(std::abs(d)).margin(1e-12));  // at the distance
+    double nearest = 1e9;
+    for (const auto& s : samples.points) nearest = std::min(nearest, (s - p).norm());
+    REQUIRE(nearest >= std::abs(d) - 1e-12);
+    REQUIRE(nearest <= std::abs(d) + 1.5e-3);
+    const taxel::Vec3d n = cone.normal(p);
+    REQUIRE(n.norm() == Approx(1.0).epsilon(1e-12));
+    if (std::abs(d) > 1e-9) {  // away from the surface, the normal points from c towards p
+      REQUIRE(n.dot(p - c) * (d > 0 ? 1.0 : -1.0) > 0.0);
+    }
+  }
+  CHECK(cone.signed_distance(taxel::Vec3d(0, 0, 0)) < 0);                 // inside
+  CHECK(cone.signed_distance(taxel::Vec3d(0, 0, 0.04)) == Approx(0.01));  // above the apex
+  CHECK(cone.normal(taxel::Vec3d(0.001, 0, -0.05)) == taxel::Vec3d(0, 0, -1));
+  // Area-uniform sampling: the base holds pi R^2 / area of the samples.
+  std::size_t on_base = 0;
+  for (const auto& p : samples.points) on_base += p.z() < -0.03 + 1e-12 ? 1 : 0;
+  const double expected = 3.14159265358979 * 0.03 * 0.03 / taxel::sim::surface_area(cone);
+  CHECK(static_cast<double>(on_base) / static_cast<double>(samples.size()) ==
+        Approx(expected).margin(0.01));
+  CHECK_THROWS_AS(taxel::sim::Cone(0.0, 1.0), std::invalid_argument);
+}
+
+TEST_CASE(
+    "TriangleMesh: exact on its own surface, within the chord error of the shape it "
+    "approximates",
+    "[sim][shapes][mesh]") {
+  const taxel::sim::Sphere sphere(0.04);
+  const taxel::sim::TriangleMesh mesh = taxel::sim::icosphere(0.04, 3);
+  REQUIRE(mesh.triangles().size() == 1280);
+  // Chord error: the largest gap between the sphere and the faces (at the face centres).
+  double chord = 0.0;
+  for (std::size_t f = 0; f < mesh.triangles().size(); ++f) {
+    const auto& v = mesh.vertices()[mesh.triangles()[f][0]];
+    chord = std::max(chord, 0.04 - std::abs(mesh.face_normal(f).dot(v)));
+    REQUIRE(mesh.face_normal(f).dot(v) > 0.0);  // counter-clockwise from outside
+  }
+  const auto samples = taxel::sim::sample_surface(mesh, 50000, 2);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-0.06, 0.06);
+  for (int q = 0; q < 200; ++q) {
+    const taxel::Vec3d p(u(rng), u(rng), u(rng));
+    const double d = mesh.signed_distance(p);
+    const taxel::Vec3d c = mesh.closest_point(p);
+    REQUIRE(std::abs(mesh.signed_distance(c)) < 1e-12);
+    REQUIRE((p - c).norm() == Approx(std::abs(d)).margin(1e-12));
+    double nearest = 1e9;
+    for (const auto& s : samples.points) nearest = std::min(nearest, (s - p).norm());
+    REQUIRE(nearest >= std::abs(d) - 1e-12);
+    REQUIRE(std::abs(d - sphere.signed_distance(p)) <= chord + 1e-12);
+    if (std::abs(sphere.signed_distance(p)) > chord)
+      REQUIRE((d > 0) == (sphere.signed_distance(p) > 0));
+    REQUIRE(mesh.normal(p).dot(sphere.normal(p)) > 0.9);
+  }
+  CHECK(taxel::sim::surface_area(mesh) == Approx(taxel::sim::surface_area(sphere)).epsilon(0.02));
+  CHECK_THROWS_WITH(taxel::sim::TriangleMesh({taxel::Vec3d::Zero()}, {{0, 0, 1}}),
+                    Catch::Matchers::Contains("refers to vertex 1 of 1"));
+  CHECK_THROWS_WITH(
+      taxel::sim::TriangleMesh({taxel::Vec3d::Zero(), taxel::Vec3d::UnitX(), taxel::Vec3d::UnitX()},
+                               {{0, 1, 2}}),
+      Catch::Matchers::Contains("no area"));
+}

@@ -372,7 +372,11 @@ inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<p
           for (double j = 0; j < count; j += 1.0) {
             const double idx = body.value(p.type, "a vertex index");
             if (indices) {
-              if (!(idx >= 0 && idx < static_cast<double>(out.cloud.points.size()))) {
+              // Checked against the vertex count now, or at the end when the faces come
+              // first; `limit` bounds them before that.
+              const double limit =
+                  seen_vertex ? static_cast<double>(out.cloud.points.size()) : 4294967295.0;
+              if (!(idx >= 0 && idx < limit)) {
                 const std::string why = "face " + std::to_string(k) + " refers to vertex " +
                                         std::to_string(static_cast<long long>(idx)) + " of " +
                                         std::to_string(out.cloud.points.size());
@@ -396,6 +400,15 @@ inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<p
     }
   }
   if (!seen_vertex) throw IoError(source, "the file has no vertex element");
+  for (std::size_t t = 0; t < out.triangles.size(); ++t) {  // faces read before the vertices
+    for (const auto i : out.triangles[t]) {
+      if (i >= out.cloud.points.size()) {
+        throw IoError(source, "a face (triangle " + std::to_string(t) + ") refers to vertex " +
+                                  std::to_string(i) + " of " +
+                                  std::to_string(out.cloud.points.size()));
+      }
+    }
+  }
   // Only whitespace may follow (ASCII); nothing may follow binary data.
   const std::string_view rest = bytes.substr(body.position());
   if (binary ? !rest.empty() : rest.find_first_not_of(" \t\r\n") != std::string_view::npos) {

@@ -31,6 +31,11 @@ inline double surface_area(const Box& b) {
   return 2.0 * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x());
 }
 
+/// Surface area [m^2] (slanted side and base).
+inline double surface_area(const Cone& c) {
+  return std::numbers::pi * c.radius * (c.radius + std::hypot(c.radius, c.height));
+}
+
 /// One point drawn uniformly over the surface (by area), with its outward normal.
 template <class Rng>
 void sample_point(const Sphere& s, Rng& rng, Vec3d& p, Vec3d& n) {
@@ -75,6 +80,51 @@ void sample_point(const Box& b, Rng& rng, Vec3d& p, Vec3d& n) {
   p[axis] = sign * h[axis];
   n = Vec3d::Zero();
   n[axis] = sign;
+}
+
+template <class Rng>
+void sample_point(const Cone& c, Rng& rng, Vec3d& p, Vec3d& n) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double slant = std::hypot(c.radius, c.height);
+  const double side = std::numbers::pi * c.radius * slant;
+  const double base = std::numbers::pi * c.radius * c.radius;
+  const double phi = 2.0 * std::numbers::pi * u(rng);
+  const Vec3d radial(std::cos(phi), std::sin(phi), 0.0);
+  if (u(rng) * (side + base) < side) {
+    // Area on the side grows linearly with the distance from the apex.
+    const double t = std::sqrt(u(rng));  // fraction of the way from apex to rim
+    p = t * c.radius * radial + Vec3d(0, 0, 0.5 * c.height - t * c.height);
+    n = (c.height * radial + Vec3d(0, 0, c.radius)).normalized();
+    return;
+  }
+  p = c.radius * std::sqrt(u(rng)) * radial + Vec3d(0, 0, -0.5 * c.height);
+  n = Vec3d(0, 0, -1);
+}
+
+/// Surface area [m^2].
+inline double surface_area(const TriangleMesh& m) {
+  double a = 0.0;
+  for (std::size_t f = 0; f < m.triangles().size(); ++f) a += m.area(f);
+  return a;
+}
+
+/// Area-weighted uniform point on a mesh (a linear scan of the triangles: sample_surface on
+/// meshes costs O(triangles) per point).
+template <class Rng>
+void sample_point(const TriangleMesh& m, Rng& rng, Vec3d& p, Vec3d& n) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double pick = u(rng) * surface_area(m);
+  std::size_t f = 0;
+  while (f + 1 < m.triangles().size() && pick >= m.area(f)) pick -= m.area(f++);
+  double s = u(rng), t = u(rng);
+  if (s + t > 1.0) {
+    s = 1.0 - s;
+    t = 1.0 - t;
+  }
+  const auto& tri = m.triangles()[f];
+  const auto& v = m.vertices();
+  p = v[tri[0]] + s * (v[tri[1]] - v[tri[0]]) + t * (v[tri[2]] - v[tri[0]]);
+  n = m.face_normal(f);
 }
 
 /// Concept of a shape that sample_point can draw from.

@@ -2,10 +2,17 @@
 // Analytic shapes with exact closest point, signed distance and outward normal.
 #pragma once
 
+#include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <concepts>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "taxel/core/types.hpp"
 
@@ -118,5 +125,286 @@ struct Box {
     return n;
   }
 };
+
+/// Solid cone along z, centred at the origin: base disc of radius `radius` at z = -h/2, apex at
+/// z = +h/2 (`height` = h) [m].
+struct Cone {
+  double radius = 0.03;
+  double height = 0.06;
+
+  /// Throws std::invalid_argument unless both sizes are finite and > 0.
+  explicit Cone(double r = 0.03, double h = 0.06) : radius(r), height(h) {
+    if (!(r > 0) || !(h > 0) || !std::isfinite(r) || !std::isfinite(h)) {
+      throw std::invalid_argument("Cone: radius and height must be > 0");
+    }
+  }
+  double signed_distance(const Vec3d& p) const {
+    const Section s = section(p);
+    return s.inside ? -s.distance : s.distance;
+  }
+  Vec3d closest_point(const Vec3d& p) const { return lift(p, section(p).closest); }
+  Vec3d normal(const Vec3d& p) const {
+    const Section s = section(p);
+    Eigen::Vector2d n2;                           // outward normal in the (r, z) half-plane
+    const Eigen::Vector2d slant(height, radius);  // normal of the slanted side, unnormalised
+    if (s.feature == 0) {
+      n2 = {0.0, -1.0};
+    } else if (s.feature == 1) {
+      n2 = slant.normalized();
+    } else {  // the rim or the apex: towards the point, or the mean of the faces there
+      const Eigen::Vector2d d = s.query - s.closest;
+      n2 = d.norm() > 1e-15 && !s.inside
+               ? Eigen::Vector2d(d.normalized())
+               : Eigen::Vector2d((s.feature == 2 ? Eigen::Vector2d(0.0, -1.0) + slant.normalized()
+                                                 : Eigen::Vector2d(0.0, 1.0))
+                                     .normalized());
+    }
+    const double r = std::hypot(p.x(), p.y());
+    const Vec3d radial = r > 0 ? Vec3d(p.x() / r, p.y() / r, 0) : Vec3d::UnitX();
+    return (n2.x() * radial + Vec3d(0, 0, n2.y())).normalized();
+  }
+
+ private:
+  struct Section {
+    Eigen::Vector2d query;    // (r, z) of the point
+    Eigen::Vector2d closest;  // on the section's boundary
+    double distance = 0.0;
+    bool inside = false;
+    int feature = 0;  // 0 base, 1 slant, 2 rim, 3 apex
+  };
+  // The closest point of the triangle (0, -h/2), (R, -h/2), (0, h/2) boundary, without the
+  // axis edge, to (r, z).
+  Section section(const Vec3d& p) const {
+    Section s;
+    s.query = {std::hypot(p.x(), p.y()), p.z()};
+    const Eigen::Vector2d base0(0.0, -0.5 * height), rim(radius, -0.5 * height),
+        apex(0.0, 0.5 * height);
+    const auto on_segment = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b, double& t) {
+      const Eigen::Vector2d ab = b - a;
+      t = std::clamp((s.query - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+      return Eigen::Vector2d(a + t * ab);
+    };
+    double tb = 0.0, ts = 0.0;
+    const Eigen::Vector2d cb = on_segment(base0, rim, tb);
+    const Eigen::Vector2d cs = on_segment(rim, apex, ts);
+    const double db = (s.query - cb).norm(), ds = (s.query - cs).norm();
+    if (db <= ds) {
+      s.closest = cb;
+      s.distance = db;
+      s.feature = tb >= 1.0 ? 2 : 0;
+    } else {
+      s.closest = cs;
+      s.distance = ds;
+      s.feature = ts <= 0.0 ? 2 : ts >= 1.0 ? 3 : 1;
+    }
+    // Inside: above the base and below the slant line r / R + (z + h/2) / h <= 1.
+    s.inside = s.query.y() > -0.5 * height &&
+               s.query.x() / radius + (s.query.y() + 0.5 * height) / height < 1.0;
+    return s;
+  }
+  static Vec3d lift(const Vec3d& p, const Eigen::Vector2d& rz) {
+    const double r = std::hypot(p.x(), p.y());
+    const Vec3d radial = r > 0 ? Vec3d(p.x() / r, p.y() / r, 0) : Vec3d::UnitX();
+    return rz.x() * radial + Vec3d(0, 0, rz.y());
+  }
+};
+
+/// A closed, consistently oriented triangle mesh (counter-clockwise seen from outside), e.g.
+/// read from PLY. Exact closest point by brute force over the triangles (O(triangles) per
+/// query: meant for models of up to a few thousand triangles); the sign of the distance comes
+/// from angle-weighted pseudo-normals (Baerentzen and Aanaes 2005), exact for closed meshes.
+class TriangleMesh {
+ public:
+  using Triangle = std::array<std::uint32_t, 3>;
+
+  /// Throws std::invalid_argument for no triangles, an index out of range, a non-finite vertex
+  /// or a triangle of zero area.
+  TriangleMesh(std::vector<Vec3d> vertices, std::vector<Triangle> triangles)
+      : v_(std::move(vertices)), t_(std::move(triangles)) {
+    if (t_.empty()) throw std::invalid_argument("TriangleMesh: no triangles");
+    for (std::size_t i = 0; i < v_.size(); ++i) {
+      if (!v_[i].allFinite()) {
+        throw std::invalid_argument("TriangleMesh: vertex " + std::to_string(i) + " is not finite");
+      }
+    }
+    vertex_normal_.assign(v_.size(), Vec3d::Zero());
+    face_normal_.resize(t_.size());
+    area_.resize(t_.size());
+    for (std::size_t f = 0; f < t_.size(); ++f) {
+      for (const auto i : t_[f]) {
+        if (i >= v_.size()) {
+          throw std::invalid_argument("TriangleMesh: triangle " + std::to_string(f) +
+                                      " refers to vertex " + std::to_string(i) + " of " +
+                                      std::to_string(v_.size()));
+        }
+      }
+      const Vec3d& a = v_[t_[f][0]];
+      const Vec3d& b = v_[t_[f][1]];
+      const Vec3d& c = v_[t_[f][2]];
+      const Vec3d cross = (b - a).cross(c - a);
+      area_[f] = 0.5 * cross.norm();
+      if (!(area_[f] > 0.0)) {
+        throw std::invalid_argument("TriangleMesh: triangle " + std::to_string(f) + " has no area");
+      }
+      face_normal_[f] = cross.normalized();
+      // Angle-weighted vertex pseudo-normals; edge pseudo-normals by edge key.
+      for (int k = 0; k < 3; ++k) {
+        const Vec3d& p = v_[t_[f][static_cast<std::size_t>(k)]];
+        const Vec3d e1 = (v_[t_[f][static_cast<std::size_t>((k + 1) % 3)]] - p).normalized();
+        const Vec3d e2 = (v_[t_[f][static_cast<std::size_t>((k + 2) % 3)]] - p).normalized();
+        vertex_normal_[t_[f][static_cast<std::size_t>(k)]] +=
+            std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * face_normal_[f];
+      }
+    }
+    edge_normal_.resize(t_.size());
+    std::vector<std::pair<std::uint64_t, std::size_t>> edges;  // (key, face * 3 + k)
+    edges.reserve(3 * t_.size());
+    for (std::size_t f = 0; f < t_.size(); ++f) {
+      for (std::size_t k = 0; k < 3; ++k)
+        edges.emplace_back(edge_key(t_[f][k], t_[f][(k + 1) % 3]), f * 3 + k);
+    }
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      Vec3d sum = Vec3d::Zero();
+      while (j < edges.size() && edges[j].first == edges[i].first)
+        sum += face_normal_[edges[j++].second / 3];
+      for (std::size_t k = i; k < j; ++k)
+        edge_normal_[edges[k].second / 3][edges[k].second % 3] = sum;
+      i = j;
+    }
+  }
+
+  [[nodiscard]] const std::vector<Vec3d>& vertices() const noexcept { return v_; }
+  [[nodiscard]] const std::vector<Triangle>& triangles() const noexcept { return t_; }
+  /// Area of triangle f [m^2].
+  [[nodiscard]] double area(std::size_t f) const { return area_.at(f); }
+  /// Unit normal of triangle f.
+  [[nodiscard]] const Vec3d& face_normal(std::size_t f) const { return face_normal_.at(f); }
+
+  double signed_distance(const Vec3d& p) const {
+    const Hit h = nearest(p);
+    const double d = std::sqrt(h.d2);
+    return (p - h.point).dot(h.pseudo_normal) < 0.0 ? -d : d;
+  }
+  Vec3d closest_point(const Vec3d& p) const { return nearest(p).point; }
+  /// The face normal where the closest point lies inside a face; the pseudo-normal (or the
+  /// direction to p) on edges and vertices.
+  Vec3d normal(const Vec3d& p) const {
+    const Hit h = nearest(p);
+    if (h.feature == 6) return face_normal_[h.face];
+    const Vec3d d = p - h.point;
+    const double sign = d.dot(h.pseudo_normal) < 0.0 ? -1.0 : 1.0;
+    return d.norm() > 1e-12 ? Vec3d(sign * d.normalized()) : Vec3d(h.pseudo_normal.normalized());
+  }
+
+ private:
+  struct Hit {
+    Vec3d point = Vec3d::Zero();
+    Vec3d pseudo_normal = Vec3d::UnitZ();
+    double d2 = std::numeric_limits<double>::infinity();
+    std::size_t face = 0;
+    int feature = 6;  // 0-2 vertex k, 3-5 edge k (from vertex k to k+1), 6 face
+  };
+
+  static std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+    return a < b ? (std::uint64_t{a} << 32) | b : (std::uint64_t{b} << 32) | a;
+  }
+
+  Hit nearest(const Vec3d& p) const {
+    Hit best;
+    for (std::size_t f = 0; f < t_.size(); ++f) {
+      int feature = 6;
+      const Vec3d c = closest_on_triangle(p, v_[t_[f][0]], v_[t_[f][1]], v_[t_[f][2]], feature);
+      const double d2 = (p - c).squaredNorm();
+      if (d2 < best.d2) {
+        best.d2 = d2;
+        best.point = c;
+        best.face = f;
+        best.feature = feature;
+      }
+    }
+    const auto& tri = t_[best.face];
+    best.pseudo_normal =
+        best.feature < 3   ? vertex_normal_[tri[static_cast<std::size_t>(best.feature)]]
+        : best.feature < 6 ? edge_normal_[best.face][static_cast<std::size_t>(best.feature - 3)]
+                           : face_normal_[best.face];
+    return best;
+  }
+
+  // Closest point of triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5), with
+  // the feature it lies on.
+  static Vec3d closest_on_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                                   int& feature) {
+    const Vec3d ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0 && d2 <= 0) return feature = 0, a;
+    const Vec3d bp = p - b;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0 && d4 <= d3) return feature = 1, b;
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return feature = 3, Vec3d(a + (d1 / (d1 - d3)) * ab);
+    const Vec3d cp = p - c;
+    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0 && d5 <= d6) return feature = 2, c;
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return feature = 5, Vec3d(a + (d2 / (d2 - d6)) * ac);
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+      return feature = 4, Vec3d(b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b));
+    }
+    const double denom = 1.0 / (va + vb + vc);
+    feature = 6;
+    return a + ab * (vb * denom) + ac * (vc * denom);
+  }
+
+  std::vector<Vec3d> v_;
+  std::vector<Triangle> t_;
+  std::vector<Vec3d> face_normal_;
+  std::vector<double> area_;
+  std::vector<Vec3d> vertex_normal_;
+  std::vector<std::array<Vec3d, 3>> edge_normal_;  // per face, edge k from vertex k to k + 1
+};
+
+/// A sphere of radius r tessellated as an icosphere: the icosahedron, each triangle split in
+/// four `subdivisions` times, vertices pushed onto the sphere (20 * 4^s triangles).
+inline TriangleMesh icosphere(double r, int subdivisions) {
+  if (!(r > 0) || subdivisions < 0 || subdivisions > 7) {
+    throw std::invalid_argument("icosphere: r must be > 0 and subdivisions in [0, 7]");
+  }
+  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec3d> v{{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                       {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<TriangleMesh::Triangle> t{
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (auto& p : v) p.normalize();
+  for (int s = 0; s < subdivisions; ++s) {
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> mids;
+    const auto mid = [&](std::uint32_t a, std::uint32_t b) {
+      const std::uint64_t key = a < b ? (std::uint64_t{a} << 32) | b : (std::uint64_t{b} << 32) | a;
+      for (const auto& [k, i] : mids) {
+        if (k == key) return i;
+      }
+      v.push_back((v[a] + v[b]).normalized());
+      mids.emplace_back(key, static_cast<std::uint32_t>(v.size() - 1));
+      return mids.back().second;
+    };
+    std::vector<TriangleMesh::Triangle> next;
+    next.reserve(t.size() * 4);
+    for (const auto& tri : t) {
+      const std::uint32_t ab = mid(tri[0], tri[1]), bc = mid(tri[1], tri[2]),
+                          ca = mid(tri[2], tri[0]);
+      next.push_back({tri[0], ab, ca});
+      next.push_back({tri[1], bc, ab});
+      next.push_back({tri[2], ca, bc});
+      next.push_back({ab, bc, ca});
+    }
+    t = std::move(next);
+  }
+  for (auto& p : v) p *= r;
+  return TriangleMesh(std::move(v), std::move(t));
+}
 
 }  // namespace taxel::sim
