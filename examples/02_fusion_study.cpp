@@ -16,6 +16,8 @@
 #include <taxel/taxel.hpp>
 #include <vector>
 
+#include "cli.hpp"
+
 namespace {
 
 using namespace taxel;
@@ -116,29 +118,19 @@ void study(const char* name, const Shape& shape, std::size_t n, const sim::Slidi
   }
 }
 
+constexpr const char* kUsage =
+    "usage: 02_fusion_study [--quick] [--out DIR]\n"
+    "Raw vs Average vs Kalman fusion of simulated explorations of five shapes: points,\n"
+    "compaction, distance to the true surface, coverage; PLY clouds and an SVG plot of error\n"
+    "against contacts.\n";
+
 }  // namespace
 
 int main(int argc, char** argv) try {
-  bool quick = false;
-  std::filesystem::path out = "fusion-study";
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--quick") {
-      quick = true;
-    } else if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "-h" || a == "--help") {
-      std::puts(
-          "usage: 02_fusion_study [--quick] [--out DIR]\n"
-          "Raw vs Average vs Kalman fusion of simulated explorations of five shapes:\n"
-          "points, compaction, distance to the true surface, coverage; PLY clouds and an\n"
-          "SVG plot of error against contacts.");
-      return 0;
-    } else {
-      std::fprintf(stderr, "02_fusion_study: unknown argument '%s' (try --help)\n", argv[i]);
-      return 2;
-    }
-  }
+  const taxel_cli::StudyOptions opt =
+      taxel_cli::parse_study_options("02_fusion_study", kUsage, "fusion-study", argc, argv);
+  const bool quick = opt.quick;
+  const std::filesystem::path out = opt.out;
   std::filesystem::create_directories(out);
   const std::size_t n = quick ? 16000 : 128000;
 

@@ -13,6 +13,8 @@
 #include <string_view>
 #include <taxel/taxel.hpp>
 
+#include "cli.hpp"
+
 namespace {
 
 using namespace taxel;
@@ -45,28 +47,18 @@ void align(const char* name, const tr::Target<double>& model, const PointCloud<d
       1e3 * err.translation().norm());
 }
 
+constexpr const char* kUsage =
+    "usage: 03_icp_align [--quick] [--out DIR]\n"
+    "Fuses a simulated sliding exploration of a box with Kalman filters and aligns the cloud\n"
+    "to the box model by ICP (point-to-point, point-to-plane, Huber).\n";
+
 }  // namespace
 
 int main(int argc, char** argv) try {
-  bool quick = false;
-  std::filesystem::path out = "icp-align";
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--quick") {
-      quick = true;
-    } else if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "-h" || a == "--help") {
-      std::puts(
-          "usage: 03_icp_align [--quick] [--out DIR]\n"
-          "Fuses a simulated sliding exploration of a box with Kalman filters and aligns\n"
-          "the cloud to the box model by ICP (point-to-point, point-to-plane, Huber).");
-      return 0;
-    } else {
-      std::fprintf(stderr, "03_icp_align: unknown argument '%s' (try --help)\n", argv[i]);
-      return 2;
-    }
-  }
+  const taxel_cli::StudyOptions opt =
+      taxel_cli::parse_study_options("03_icp_align", kUsage, "icp-align", argc, argv);
+  const bool quick = opt.quick;
+  const std::filesystem::path out = opt.out;
   std::filesystem::create_directories(out);
   const sim::Box box(Vec3d(0.04, 0.03, 0.02));
 

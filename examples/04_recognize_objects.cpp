@@ -16,6 +16,8 @@
 #include <taxel/taxel.hpp>
 #include <vector>
 
+#include "cli.hpp"
+
 namespace {
 
 using namespace taxel;
@@ -37,35 +39,24 @@ Object make(std::string name, Shape shape) {
       }};
 }
 
+constexpr const char* kUsage =
+    "usage: 04_recognize_objects [--quick] [--trials N] [--out DIR]\n"
+    "Explores seven simulated objects by touch, fuses the contacts with Kalman filters and\n"
+    "recognises each cloud among the seven models by multi-start ICP.\n";
+
 }  // namespace
 
 int main(int argc, char** argv) try {
   int trials = 5;
-  std::filesystem::path out = "recognize-objects";
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--quick") {
-      trials = 1;
-    } else if (a == "--trials" && i + 1 < argc) {
-      const std::string_view v = argv[++i];
-      if (std::from_chars(v.data(), v.data() + v.size(), trials).ptr != v.data() + v.size() ||
-          trials < 1 || trials > 1000) {
-        std::fprintf(stderr, "04_recognize_objects: --trials must be an integer in [1, 1000]\n");
-        return 2;
-      }
-    } else if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "-h" || a == "--help") {
-      std::puts(
-          "usage: 04_recognize_objects [--quick] [--trials N] [--out DIR]\n"
-          "Explores seven simulated objects by touch, fuses the contacts with Kalman\n"
-          "filters and recognises each cloud among the seven models by multi-start ICP.");
-      return 0;
-    } else {
-      std::fprintf(stderr, "04_recognize_objects: unknown argument '%s' (try --help)\n", argv[i]);
-      return 2;
-    }
-  }
+  const taxel_cli::StudyOptions opt =
+      taxel_cli::parse_study_options("04_recognize_objects", kUsage, "recognize-objects", argc,
+                                     argv, [&](std::string_view a, taxel_cli::Args& args) {
+                                       if (a != "--trials") return false;
+                                       trials = args.number<int>(1, 1000);
+                                       return true;
+                                     });
+  if (opt.quick) trials = 1;
+  const std::filesystem::path out = opt.out;
   const std::vector<Object> objects{
       make("sphere-40", sim::Sphere(0.04)),
       make("sphere-25", sim::Sphere(0.025)),

@@ -57,6 +57,38 @@ class Args {
   std::string_view current_;
 };
 
+/// The options every study example takes: --quick, --out DIR, -h/--help (which prints `usage`
+/// and exits). `extra(arg, args)` may claim further options by returning true.
+struct StudyOptions {
+  bool quick = false;
+  std::string out;
+};
+template <class Extra>
+StudyOptions parse_study_options(const char* tool, const char* usage, std::string default_out,
+                                 int argc, char** argv, Extra extra) {
+  Args args(tool, argc, argv);
+  StudyOptions o{false, std::move(default_out)};
+  std::string_view a;
+  while (args.next(a)) {
+    if (a == "--quick") {
+      o.quick = true;
+    } else if (a == "--out") {
+      o.out = std::string(args.value());
+    } else if (a == "-h" || a == "--help") {
+      std::fputs(usage, stdout);
+      std::exit(0);
+    } else if (!extra(a, args)) {
+      args.fail("unknown argument '" + std::string(a) + "' (see --help)");
+    }
+  }
+  return o;
+}
+inline StudyOptions parse_study_options(const char* tool, const char* usage,
+                                        std::string default_out, int argc, char** argv) {
+  return parse_study_options(tool, usage, std::move(default_out), argc, argv,
+                             [](std::string_view, Args&) { return false; });
+}
+
 /// `s` with quotes and backslashes escaped and control characters blanked, for JSON strings.
 inline std::string json_escape(std::string_view s) {
   std::string out;
