@@ -130,7 +130,7 @@ TEST_CASE("regionprops: Octave's MATLAB-compatibility vectors", "[image]") {
   CHECK(ti::region_props(vertical).orientation == 90);
 }
 
-TEST_CASE("regionprops: perimeter of rectangles in closed form; empty regions", "[image]") {
+TEST_CASE("regionprops: perimeter of rectangles in closed form, empty regions", "[image]") {
   for (int h = 2; h <= 6; ++h) {
     for (int w = 2; w <= 7; ++w) {
       ti::Mask m = ti::Mask::Zero(h + 4, w + 3);
@@ -210,7 +210,7 @@ ti::Mask random_mask(std::mt19937& rng, Eigen::Index rows, Eigen::Index cols, do
 
 }  // namespace
 
-TEST_CASE("components agree with a union-find oracle; bwareaopen", "[image]") {
+TEST_CASE("components agree with a union-find oracle, bwareaopen", "[image]") {
   std::mt19937 rng(7);
   ti::Components comp;
   for (int trial = 0; trial < 300; ++trial) {
@@ -368,7 +368,7 @@ double exhaustive_sse(std::vector<double> v, int k) {
 }
 }  // namespace
 
-TEST_CASE("k-means: the DP optimum equals exhaustive search; histogram path agrees", "[image]") {
+TEST_CASE("k-means: the DP optimum equals exhaustive search, histogram path agrees", "[image]") {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 500; ++trial) {
     const int n = 1 + trial % 11;

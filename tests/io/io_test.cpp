@@ -169,7 +169,7 @@ TEST_CASE("NPY images: dtypes, stacks, Fortran order, versions, strict errors", 
   CHECK_THROWS_WITH(tio::parse_npy(cut), Contains("header of"));
 }
 
-TEST_CASE("image files by extension; pictures", "[io]") {
+TEST_CASE("image files by extension, pictures", "[io]") {
   const auto dir = std::filesystem::temp_directory_path() / "taxel_io_test";
   std::filesystem::create_directories(dir);
   const ti::ImageD img = ramp_image(5, 7);

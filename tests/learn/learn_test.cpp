@@ -348,7 +348,7 @@ TEST_CASE("K-fold assignments are stratified, or keep groups together", "[learn]
   CHECK_THAT(kfold_assignment(d.y, 11, 1, d.groups).message, Contains("only 10 groups"));
 }
 
-TEST_CASE("cross_validate reports a consistent confusion matrix; noise hurts", "[learn]") {
+TEST_CASE("cross_validate reports a consistent confusion matrix, noise hurts", "[learn]") {
   const Dataset d = taxel_test::blobs(40, 4, 6, 4.0, 13);
   const CvReport r = cross_validate(LinearSvm{}, d.view());
   REQUIRE(r.ok());
@@ -381,7 +381,7 @@ TEST_CASE("cross_validate reports a consistent confusion matrix; noise hurts", "
         Status::invalid_input);
 }
 
-TEST_CASE("Student t CDF agrees with closed forms; quantiles give the 5x2cv thresholds",
+TEST_CASE("Student t CDF agrees with closed forms, quantiles give the 5x2cv thresholds",
           "[learn]") {
   for (const double t : {-3.0, -0.7, 0.0, 0.4, 1.3, 2.5, 8.0}) {
     INFO("t = " << t);

@@ -145,7 +145,7 @@ TEST_CASE("Target: PCA normals, exact nearest with the closest-point field, erro
 }
 
 TEST_CASE(
-    "ICP recovers known transforms exactly without noise; point-to-plane needs fewer "
+    "ICP recovers known transforms exactly without noise, point-to-plane needs fewer "
     "iterations",
     "[registration][icp]") {
   const PointCloud<double> model = asymmetric(6000, 1);

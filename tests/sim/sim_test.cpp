@@ -87,7 +87,7 @@ TEST_CASE("Reconstruction metrics: distances, coverage, compaction", "[sim][metr
                   std::invalid_argument);
 }
 
-TEST_CASE("Cone: exact closest point, signed distance, normals; uniform sampling",
+TEST_CASE("Cone: exact closest point, signed distance, normals, uniform sampling",
           "[sim][shapes]") {
   const taxel::sim::Cone cone(0.03, 0.06);
   // Dense surface samples as a brute-force oracle: no sample is nearer than the exact distance,
