@@ -457,6 +457,8 @@ TEST_CASE("ObjectLibrary recognises partial, noisy, randomly posed clouds",
   CHECK_THAT(bad.message, Contains("2 finite cloud points"));
   CHECK(ObjectLibrary<double>{}.recognize(blob).status == Status::invalid_input);
   CHECK_THROWS_WITH(lib.add("cube 50", objects[0].sample(100, 1)), Contains("'cube 50' exists"));
+  CHECK_THROWS_WITH(ObjectLibrary<double>(LibraryConfig{.field_cell = -1.0}),
+                    Contains("field_cell"));
   CHECK_THROWS_WITH(ObjectLibrary<double>(LibraryConfig{.rotation_starts = 30}),
                     Contains("rotation_starts"));
 }

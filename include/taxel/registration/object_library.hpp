@@ -2,11 +2,13 @@
 // Recognition of a partial tactile cloud among known object models by multi-start ICP
 // (the first paper's "ICP alignment and classification"): every model is tried from starts
 // that align the cloud's principal axes with the model's (4 proper sign choices) and from the
-// 24 rotations of the cube's rotation group, each about the centroids. Starts run a few coarse
-// point-to-plane iterations on a subsample; hopeless ones stop early; the best few are refined
-// on the whole cloud. Models are ranked by the truncated RMS distance of all cloud points to
-// the model (points beyond the gate count as the gate), and the answer is `unknown` when even
-// the best model is farther than a threshold.
+// 24 rotations of the cube's rotation group, each about the centroids. Each start runs a few
+// point-to-plane iterations on a 64-point subsample against the model's closest-point field;
+// hopeless starts stop after three; the best two per model are refined on 512 points, still on
+// the field; the three best models are then refined with exact correspondences. Models are
+// ranked by the truncated RMS distance of all cloud points to the model (points beyond the gate
+// count as the gate), and the answer is `unknown` when even the best model is farther than a
+// threshold.
 #pragma once
 
 #include <Eigen/Eigenvalues>
@@ -119,6 +121,9 @@ class ObjectLibrary {
     if (!(cfg_.score_gate > 0.0) || !(cfg_.unknown_score > 0.0)) {
       bad("score_gate and unknown_score must be > 0");
     }
+    if (!(cfg_.field_cell >= 0.0) || !std::isfinite(cfg_.field_cell)) {
+      bad("field_cell must be finite and >= 0");
+    }
     (void)Icp<PointToPlane>(cfg_.refine);  // validates the refinement options
   }
 
@@ -140,9 +145,9 @@ class ObjectLibrary {
   [[nodiscard]] const Target<S>& target(std::size_t i) const { return models_.at(i).target; }
   [[nodiscard]] const LibraryConfig& config() const noexcept { return cfg_; }
 
-  /// Ranks every model for `cloud`. Non-finite points are ignored; fewer than 6 finite points,
-  /// or a collinear or planar cloud's missing axes, still give a ranking; an empty library or
-  /// cloud gives `invalid_input`.
+  /// Ranks every model for `cloud`. Non-finite points are ignored. An empty library or fewer
+  /// than 6 finite points give `invalid_input`; a collinear or planar cloud still gets a ranking
+  /// (its starts then differ only by the cube rotations).
   [[nodiscard]] ObjectRecognition recognize(const PointCloud<S>& cloud) const {
     ObjectRecognition out;
     std::vector<Vec3<S>> pts;
