@@ -2,8 +2,10 @@
 // Umbrella header of taxel::sim.
 #pragma once
 
+#include "taxel/sim/exploration.hpp"
 #include "taxel/sim/metrics.hpp"
 #include "taxel/sim/palm_grasp.hpp"
 #include "taxel/sim/sampling.hpp"
+#include "taxel/sim/sensor.hpp"
 #include "taxel/sim/shapes.hpp"
 #include "taxel/sim/sliding.hpp"

@@ -1,0 +1,306 @@
+// SPDX-License-Identifier: MIT
+// Explorations with the tactile pad model (sensor.hpp): a pad sliding over a shape, a multi-pad
+// hand closing on it, and a fingertip palpating it. Each yields time-stamped frames of pad
+// readings and contacts, with the ground-truth shape and pose. Seeded and deterministic.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "taxel/core/contact.hpp"
+#include "taxel/core/point_cloud.hpp"
+#include "taxel/sim/sampling.hpp"
+#include "taxel/sim/sensor.hpp"
+#include "taxel/sim/shapes.hpp"
+
+namespace taxel::sim {
+
+/// Settings shared by every exploration.
+struct ExplorationConfig {
+  SensorModel sensor;                          ///< the pads (all pads of a hand are alike)
+  ContactMode mode = ContactMode::per_tactel;  ///< contacts per active tactel or per pad
+  double frame_rate = 1000.0;                  ///< frames per second [Hz], > 0
+  double indentation = 1.0e-3;                 ///< how far a pad presses into the object [m], > 0
+  Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  ///< shape frame -> world
+  std::uint64_t seed = 1;                                         ///< equal seeds, equal output
+
+  /// Throws std::invalid_argument naming the first parameter out of range.
+  void validate() const {
+    sensor.validate();
+    if (!(frame_rate > 0) || !std::isfinite(frame_rate))
+      throw std::invalid_argument("ExplorationConfig: frame_rate must be finite and > 0");
+    if (!(indentation > 0) || !std::isfinite(indentation))
+      throw std::invalid_argument("ExplorationConfig: indentation must be finite and > 0");
+    if (!object_pose.matrix().allFinite())
+      throw std::invalid_argument("ExplorationConfig: object_pose must be finite");
+  }
+};
+
+/// One frame: the readings of the pads in use and the contacts they gave (world frame).
+struct ExplorationFrame {
+  double time = 0.0;                      ///< [s]
+  std::vector<PadReading> pads;           ///< one per pad in use this frame
+  std::vector<Contact<double>> contacts;  ///< from all pads, in pad order
+};
+
+/// An exploration's output and its ground truth.
+template <Shape Sh>
+struct Exploration {
+  Posed<Sh> truth;                       ///< the explored shape at its world pose
+  std::vector<ExplorationFrame> frames;  ///< in time order
+
+  /// Number of contacts over all frames.
+  std::size_t contact_count() const {
+    std::size_t n = 0;
+    for (const auto& f : frames) n += f.contacts.size();
+    return n;
+  }
+  /// All contacts in time order.
+  std::vector<Contact<double>> contacts() const {
+    std::vector<Contact<double>> out;
+    out.reserve(contact_count());
+    for (const auto& f : frames) out.insert(out.end(), f.contacts.begin(), f.contacts.end());
+    return out;
+  }
+};
+
+/// A sliding exploration: the pad pressed `indentation` into the surface with its face tangent
+/// to it, its long side along a random-walk heading.
+struct SlideParams {
+  int slides = 4;               ///< slides from random starts, >= 1
+  std::size_t frames = 1000;    ///< frames per slide, >= 1
+  double speed = 0.05;          ///< [m/s], >= 0
+  double heading_sigma = 0.05;  ///< random-walk step of the heading [rad/frame], >= 0
+};
+
+/// Grasps of a hand with `fingers` fingers evenly spread around a random grasp axis, each with
+/// `pads_per_finger` pads along it `pad_spacing` apart. Each finger closes straight towards the
+/// axis at `closing_speed` and stops `indentation` past its first touch (a compliant,
+/// position-controlled hand); then the hand holds for `hold_frames` frames and lets go. Pads that
+/// touch nothing within the object's reach are left out of the grasp's frames.
+struct GraspParams {
+  int grasps = 8;               ///< grasps with random axes, >= 1
+  int fingers = 3;              ///< >= 1 (an SDH-2 has 3)
+  int pads_per_finger = 2;      ///< proximal and distal, >= 1
+  double pad_spacing = 0.05;    ///< distance of the pads along a finger [m], >= 0
+  double closing_speed = 0.05;  ///< [m/s], > 0
+  int hold_frames = 50;         ///< >= 0
+};
+
+/// Palpation: one pad pokes the surface at uniformly random points, its face tangent there,
+/// pressing in at `press_speed` to `indentation`, holding `hold_frames` frames.
+struct PalpationParams {
+  int touches = 40;           ///< >= 1
+  double press_speed = 0.02;  ///< [m/s], > 0
+  int hold_frames = 10;       ///< >= 0
+};
+
+namespace detail {
+
+/// Pad pose with face normal `z` (looking into the object), long side (pad y) along `y`
+/// (orthogonalised), at `origin`.
+inline Eigen::Isometry3d pad_pose(const Vec3d& z, const Vec3d& y_hint, const Vec3d& origin) {
+  Vec3d y = y_hint - y_hint.dot(z) * z;
+  y = y.norm() > 1e-9 ? Vec3d(y.normalized()) : z.unitOrthogonal();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear().col(0) = y.cross(z);
+  T.linear().col(1) = y;
+  T.linear().col(2) = z;
+  T.translation() = origin;
+  return T;
+}
+
+template <class Rng>
+Vec3d random_unit(Rng& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  Vec3d d(g(rng), g(rng), g(rng));
+  while (d.squaredNorm() < 1e-24) d = Vec3d(g(rng), g(rng), g(rng));
+  return d.normalized();
+}
+
+/// Smallest signed distance of a pad's tactels to the shape (negative: some tactel is inside).
+template <Shape Sh>
+double deepest(const Sh& shape, const PadGeometry& g, const Eigen::Isometry3d& pose) {
+  double d = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) d = std::min(d, shape.signed_distance(pose * g.tactel(r, c)));
+  return d;
+}
+
+template <Shape Sh>
+void add_frame(Exploration<Sh>& ex, const ExplorationConfig& cfg, double time,
+               std::vector<PadReading>&& pads) {
+  ExplorationFrame f;
+  f.time = time;
+  f.pads = std::move(pads);
+  for (const auto& p : f.pads) pad_contacts(p, cfg.sensor, cfg.mode, time, f.contacts);
+  ex.frames.push_back(std::move(f));
+}
+
+}  // namespace detail
+
+/// Slides a pad over `shape` (placed at cfg.object_pose): `p.slides` slides of `p.frames`
+/// frames from random starts. Throws std::invalid_argument for invalid parameters.
+template <SampleableShape Sh>
+Exploration<Sh> explore_sliding(const Sh& shape, const ExplorationConfig& cfg,
+                                const SlideParams& p = {}) {
+  cfg.validate();
+  if (p.slides < 1 || p.frames < 1 || !(p.speed >= 0) || !std::isfinite(p.speed) ||
+      !(p.heading_sigma >= 0) || !std::isfinite(p.heading_sigma)) {
+    throw std::invalid_argument(
+        "SlideParams: slides and frames must be >= 1, speed and heading_sigma finite and >= 0");
+  }
+  Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
+  const Posed<Sh>& world = ex.truth;
+  std::mt19937_64 rng(cfg.seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double step = p.speed / cfg.frame_rate;
+  ex.frames.reserve(static_cast<std::size_t>(p.slides) * p.frames);
+  std::size_t tick = 0;
+  for (int s = 0; s < p.slides; ++s) {
+    Vec3d at, n;
+    sample_point(world, rng, at, n);
+    Vec3d heading = n.cross(detail::random_unit(rng));
+    if (heading.norm() < 1e-9) heading = n.unitOrthogonal();
+    heading.normalize();
+    for (std::size_t f = 0; f < p.frames; ++f, ++tick) {
+      const Eigen::Isometry3d pose = detail::pad_pose(-n, heading, at - cfg.indentation * n);
+      std::vector<PadReading> pads;
+      pads.push_back(read_pad(world, cfg.sensor, pose, rng, 0));
+      detail::add_frame(ex, cfg, double(tick) / cfg.frame_rate, std::move(pads));
+      heading = Eigen::AngleAxisd(p.heading_sigma * gauss(rng), n) * heading;
+      at = world.closest_point(at + step * heading);
+      const Vec3d n_new = world.normal(at);
+      const Vec3d h = heading - heading.dot(n_new) * n_new;
+      heading = h.norm() > 1e-9 ? Vec3d(h.normalized()) : n_new.unitOrthogonal();
+      n = n_new;
+    }
+  }
+  return ex;
+}
+
+/// Closes a multi-pad hand on `shape` (placed at cfg.object_pose) `p.grasps` times. Throws
+/// std::invalid_argument for invalid parameters.
+template <SampleableShape Sh>
+Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
+                               const GraspParams& p = {}) {
+  cfg.validate();
+  if (p.grasps < 1 || p.fingers < 1 || p.pads_per_finger < 1 || p.fingers > 64 ||
+      p.pads_per_finger > 64 || !(p.pad_spacing >= 0) || !std::isfinite(p.pad_spacing) ||
+      !(p.closing_speed > 0) || !std::isfinite(p.closing_speed) || p.hold_frames < 0) {
+    throw std::invalid_argument(
+        "GraspParams: grasps >= 1, fingers and pads_per_finger in [1, 64], pad_spacing >= 0, "
+        "closing_speed > 0 and hold_frames >= 0");
+  }
+  Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
+  const Posed<Sh>& world = ex.truth;
+  // Centre and reach of the object, from surface samples.
+  const PointCloud<double> samples = sample_surface(world, 2000, cfg.seed ^ 0x5eedULL);
+  Vec3d centre = Vec3d::Zero();
+  for (const auto& q : samples.points) centre += q;
+  centre /= double(samples.size());
+  double reach = 0.0;
+  for (const auto& q : samples.points) reach = std::max(reach, (q - centre).norm());
+  const PadGeometry& g = cfg.sensor.geometry;
+  const double half_diag = 0.5 * g.pitch * std::hypot(g.rows, g.cols);
+  const double start = 1.2 * reach + cfg.indentation + 2e-3;  // pads start clear of the object
+  const double scan = std::min(0.5 * g.pitch, 0.25 * reach);  // finer than any pad feature
+  const double step = p.closing_speed / cfg.frame_rate;
+
+  std::mt19937_64 rng(cfg.seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::size_t tick = 0;
+  for (int k = 0; k < p.grasps; ++k) {
+    const Vec3d axis = detail::random_unit(rng);
+    const Vec3d e1 = axis.unitOrthogonal();
+    const Vec3d e2 = axis.cross(e1);
+    const double phase = std::numbers::pi * uniform(rng);
+    const double height = 0.3 * reach * uniform(rng);  // where along the axis the hand grips
+    struct Pad {
+      Vec3d origin, inward;
+      double touch;  // closing distance at first touch
+    };
+    std::vector<Pad> pads;
+    for (int f = 0; f < p.fingers; ++f) {
+      const double phi = phase + 2.0 * std::numbers::pi * f / p.fingers;
+      const Vec3d radial = std::cos(phi) * e1 + std::sin(phi) * e2;
+      for (int j = 0; j < p.pads_per_finger; ++j) {
+        const double h = height + (j - 0.5 * (p.pads_per_finger - 1)) * p.pad_spacing;
+        Pad pad{centre + h * axis + (start + half_diag) * radial, -radial, -1.0};
+        const auto at = [&](double s) {
+          return detail::pad_pose(pad.inward, axis, pad.origin + s * pad.inward);
+        };
+        // March until a tactel enters the object, then bisect the touching distance.
+        double lo = 0.0;
+        for (double s = 0.0; s <= 2.0 * (start + half_diag); s += scan) {
+          if (detail::deepest(world, g, at(s)) <= 0.0) {
+            double hi = s;
+            for (int it = 0; it < 50; ++it) {
+              const double mid = 0.5 * (lo + hi);
+              (detail::deepest(world, g, at(mid)) <= 0.0 ? hi : lo) = mid;
+            }
+            pad.touch = hi;
+            break;
+          }
+          lo = s;
+        }
+        if (pad.touch >= 0.0) pads.push_back(pad);
+      }
+    }
+    if (pads.empty()) continue;
+    const int closing = static_cast<int>(std::ceil(cfg.indentation / step)) + 2;
+    for (int f = 0; f < closing + p.hold_frames; ++f, ++tick) {
+      const double s_rel = std::min(double(f - 2) * step, cfg.indentation);
+      std::vector<PadReading> readings;
+      for (std::size_t i = 0; i < pads.size(); ++i) {
+        const Pad& pad = pads[i];
+        const Eigen::Isometry3d pose =
+            detail::pad_pose(pad.inward, axis, pad.origin + (pad.touch + s_rel) * pad.inward);
+        readings.push_back(read_pad(world, cfg.sensor, pose, rng, static_cast<int>(i)));
+      }
+      detail::add_frame(ex, cfg, double(tick) / cfg.frame_rate, std::move(readings));
+    }
+  }
+  return ex;
+}
+
+/// Palpates `shape` (placed at cfg.object_pose) `p.touches` times with one pad. Throws
+/// std::invalid_argument for invalid parameters.
+template <SampleableShape Sh>
+Exploration<Sh> explore_palpation(const Sh& shape, const ExplorationConfig& cfg,
+                                  const PalpationParams& p = {}) {
+  cfg.validate();
+  if (p.touches < 1 || !(p.press_speed > 0) || !std::isfinite(p.press_speed) || p.hold_frames < 0) {
+    throw std::invalid_argument(
+        "PalpationParams: touches >= 1, press_speed > 0 and hold_frames >= 0");
+  }
+  Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
+  const Posed<Sh>& world = ex.truth;
+  std::mt19937_64 rng(cfg.seed);
+  const double step = p.press_speed / cfg.frame_rate;
+  const int pressing = static_cast<int>(std::ceil(cfg.indentation / step)) + 2;
+  std::size_t tick = 0;
+  for (int k = 0; k < p.touches; ++k) {
+    Vec3d at, n;
+    sample_point(world, rng, at, n);
+    const Vec3d y = detail::random_unit(rng);
+    for (int f = 0; f < pressing + p.hold_frames; ++f, ++tick) {
+      const double s = std::min(double(f - 2) * step, cfg.indentation);
+      std::vector<PadReading> readings;
+      readings.push_back(read_pad(world, cfg.sensor, detail::pad_pose(-n, y, at - s * n), rng, 0));
+      detail::add_frame(ex, cfg, double(tick) / cfg.frame_rate, std::move(readings));
+    }
+  }
+  return ex;
+}
+
+}  // namespace taxel::sim

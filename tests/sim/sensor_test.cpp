@@ -1,0 +1,226 @@
+// SPDX-License-Identifier: MIT
+// Tests of the tactile pad model (sensor.hpp) and the explorations built on it
+// (exploration.hpp): readings against closed-form indentation, contacts against the surface
+// they came from, the stated covariance against the measured scatter, determinism, and bad
+// parameters.
+#include <Eigen/Eigenvalues>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+#include <taxel/sim.hpp>
+
+namespace ts = taxel::sim;
+using taxel::Vec3d;
+
+namespace {
+
+ts::SensorModel noiseless() {
+  ts::SensorModel m;
+  m.sigma_normal = 0.0;
+  m.sigma_position = 0.0;
+  m.sigma_tilt = 0.0;
+  return m;
+}
+
+// A pad facing down onto the top face (z = 0.02) of the default box, pressed `depth` in.
+Eigen::Isometry3d on_box_top(double depth, double x = 0.0, double y = 0.0) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(M_PI, Vec3d::UnitX()).matrix();  // pad z -> world -z
+  T.translation() = Vec3d(x, y, 0.02 - depth);
+  return T;
+}
+
+}  // namespace
+
+TEST_CASE("pad readings follow the indentation; contacts lie on the pressed surface",
+          "[sim][sensor]") {
+  const ts::Box box;
+  ts::SensorModel m = noiseless();
+  std::mt19937_64 rng(1);
+  const double depth = 1.0e-3;
+  const ts::PadReading r = ts::read_pad(box, m, on_box_top(depth), rng);
+  REQUIRE(r.counts.rows() == 14);
+  REQUIRE(r.counts.cols() == 6);
+  const auto expected = static_cast<std::uint16_t>(std::lround(depth / m.full_scale_depth * 4095));
+  CHECK((r.counts == expected).all());
+  CHECK(r.believed_pose.isApprox(r.true_pose));
+
+  std::vector<taxel::Contact<double>> contacts;
+  CHECK(ts::pad_contacts(r, m, ts::ContactMode::per_tactel, 0.5, contacts) == 84);
+  const double quantum = m.full_scale_depth / 4095;
+  for (const auto& c : contacts) {
+    CHECK(std::abs(c.position.z() - 0.02) <= quantum);  // the undeformed face of the box
+    CHECK(c.normal->isApprox(Vec3d::UnitZ()));
+    CHECK(c.time == 0.5);
+    CHECK(taxel::check_contact(c) == taxel::ContactDefect::ok);
+    // In-plane variance: quantisation over one tactel; along the normal: depth quantisation.
+    const Eigen::SelfAdjointEigenSolver<taxel::Mat3d> eig(c.covariance);
+    CHECK(eig.eigenvalues()(2) == Approx(std::pow(3.4e-3, 2) / 12).epsilon(1e-9));
+    CHECK(c.covariance(2, 2) == Approx(quantum * quantum / 12).epsilon(1e-6));
+  }
+  // The tactel grid: x spans 5 pitches, y spans 13.
+  double xmin = 1, xmax = -1, ymin = 1, ymax = -1;
+  for (const auto& c : contacts) {
+    xmin = std::min(xmin, c.position.x());
+    xmax = std::max(xmax, c.position.x());
+    ymin = std::min(ymin, c.position.y());
+    ymax = std::max(ymax, c.position.y());
+  }
+  CHECK(xmax - xmin == Approx(5 * 3.4e-3));
+  CHECK(ymax - ymin == Approx(13 * 3.4e-3));
+
+  SECTION("one pressure-weighted contact per pad") {
+    std::vector<taxel::Contact<double>> one;
+    CHECK(ts::pad_contacts(r, m, ts::ContactMode::per_pad, 0.5, one) == 1);
+    CHECK(one[0].position.isApprox(Vec3d(0, 0, 0.02), 1e-3));
+    CHECK(std::abs(one[0].position.z() - 0.02) <= quantum);
+    CHECK(one[0].pressure == 84.0 * expected);
+  }
+  SECTION("half the pad over the edge: only the tactels on the face read") {
+    // Pad centre at x = 0.04 (the edge): columns with x > 0 hang in the air.
+    const ts::PadReading half = ts::read_pad(box, m, on_box_top(depth, 0.04), rng);
+    CHECK((half.counts.leftCols(3) == expected).all());
+    CHECK((half.counts.rightCols(3) == std::uint16_t{0}).all());
+  }
+  SECTION("saturated tactels give no per-tactel contact, lifted pads none at all") {
+    const ts::PadReading deep = ts::read_pad(box, m, on_box_top(5e-3), rng);
+    CHECK((deep.counts == std::uint16_t{4095}).all());
+    std::vector<taxel::Contact<double>> none;
+    CHECK(ts::pad_contacts(deep, m, ts::ContactMode::per_tactel, 0, none) == 0);
+    CHECK(ts::pad_contacts(deep, m, ts::ContactMode::per_pad, 0, none) == 0);
+    const ts::PadReading lifted = ts::read_pad(box, m, on_box_top(-1e-3), rng);
+    CHECK_FALSE(lifted.touching());
+    CHECK(ts::pad_contacts(lifted, m, ts::ContactMode::per_tactel, 0, none) == 0);
+  }
+  SECTION("below the threshold a tactel reads zero") {
+    const ts::PadReading light = ts::read_pad(box, m, on_box_top(0.5 * m.threshold * quantum), rng);
+    CHECK_FALSE(light.touching());
+  }
+}
+
+TEST_CASE("pad on a sphere: contacts within the curvature error of the surface", "[sim][sensor]") {
+  const ts::Sphere sphere(0.04);
+  const ts::SensorModel m = noiseless();
+  std::mt19937_64 rng(2);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(M_PI, Vec3d::UnitX()).matrix();
+  T.translation() = Vec3d(0, 0, 0.04 - 1.5e-3);
+  const ts::PadReading r = ts::read_pad(sphere, m, T, rng);
+  std::vector<taxel::Contact<double>> contacts;
+  const std::size_t n = ts::pad_contacts(r, m, ts::ContactMode::per_tactel, 0, contacts);
+  // The touching disc: tactels within sqrt(2 R d) = 11 mm of the pad centre (less the threshold).
+  std::size_t inside = 0;
+  for (int row = 0; row < 14; ++row)
+    for (int col = 0; col < 6; ++col)
+      inside += m.geometry.tactel(row, col).head<2>().norm() < 0.0105 ? 1 : 0;
+  CHECK(n >= inside);
+  CHECK(n <= 84);
+  for (const auto& c : contacts) {
+    // Compression is measured along the pad normal: the contact lies on the sphere up to the
+    // depth quantum.
+    CHECK(std::abs(sphere.signed_distance(c.position)) < 1e-6);
+  }
+}
+
+TEST_CASE("pad noise: the scatter along the normal matches the stated covariance",
+          "[sim][sensor]") {
+  const ts::Box box;
+  ts::SensorModel m;  // default noise: 0.3 mm depth, 0.2 mm position, 0.02 rad tilt
+  std::mt19937_64 rng(3);
+  double sum_ratio = 0.0;
+  std::size_t count = 0;
+  for (int frame = 0; frame < 3000; ++frame) {
+    const ts::PadReading r = ts::read_pad(box, m, on_box_top(1.5e-3), rng);
+    std::vector<taxel::Contact<double>> contacts;
+    ts::pad_contacts(r, m, ts::ContactMode::per_tactel, 0, contacts);
+    for (const auto& c : contacts) {
+      const Vec3d n = *c.normal;
+      const double e = c.position.z() - 0.02;  // the error: the face is at z = 0.02
+      // Variance the contact claims along the true normal (+z), against the squared error.
+      sum_ratio += e * e / Vec3d::UnitZ().dot(c.covariance * Vec3d::UnitZ());
+      ++count;
+      CHECK(n.z() > 0.99);
+    }
+  }
+  REQUIRE(count > 100000);
+  CHECK(sum_ratio / double(count) == Approx(1.0).margin(0.06));
+}
+
+TEST_CASE("explorations: deterministic, timed, on the surface, at the object's pose",
+          "[sim][exploration]") {
+  ts::ExplorationConfig cfg;
+  cfg.sensor = noiseless();
+  cfg.object_pose.linear() = Eigen::AngleAxisd(0.7, Vec3d(1, 2, 3).normalized()).matrix();
+  cfg.object_pose.translation() = Vec3d(0.1, -0.2, 0.3);
+  const ts::Cylinder cyl(0.03, 0.05);
+  const auto check = [&](const auto& ex, std::size_t min_contacts) {
+    INFO("frames " << ex.frames.size());
+    REQUIRE(ex.contact_count() >= min_contacts);
+    // Noise-free, contacts lie on the placed surface up to the depth quantum (0.73 um).
+    double worst = 0.0;
+    for (std::size_t f = 0; f < ex.frames.size(); ++f) {
+      CHECK(ex.frames[f].time == Approx(double(f) / cfg.frame_rate));
+      for (const auto& c : ex.frames[f].contacts) {
+        REQUIRE(c.time == ex.frames[f].time);
+        const double d = std::abs(ex.truth.signed_distance(c.position));
+        worst = std::max(worst, d);
+      }
+    }
+    CHECK(worst < 1e-6);
+    // The contacts are on the placed shape, not on the shape at the origin.
+    CHECK(std::abs(cyl.signed_distance(ex.contacts().front().position)) > 0.05);
+  };
+  const auto slide = ts::explore_sliding(cyl, cfg, {.slides = 2, .frames = 300});
+  CHECK(slide.frames.size() == 600);
+  check(slide, 600);
+  const auto grasp = ts::explore_grasps(cyl, cfg, {.grasps = 4});
+  check(grasp, 100);
+  const auto palp = ts::explore_palpation(cyl, cfg, {.touches = 10});
+  check(palp, 10);
+
+  SECTION("a grasp's pads each touch and hold") {
+    // 3 fingers x 2 pads 5 cm apart on a 10 cm cylinder: in a hold frame, every pad that took
+    // part reads something.
+    const auto& hold = grasp.frames[grasp.frames.size() - 1];
+    REQUIRE_FALSE(hold.pads.empty());
+    for (const auto& p : hold.pads) CHECK(p.touching());
+  }
+  SECTION("per-pad contacts: at most one per pad and frame") {
+    ts::ExplorationConfig per_pad = cfg;
+    per_pad.mode = ts::ContactMode::per_pad;
+    const auto g = ts::explore_grasps(cyl, per_pad, {.grasps = 4});
+    for (const auto& f : g.frames) CHECK(f.contacts.size() <= f.pads.size());
+    CHECK(g.contact_count() > 0);
+  }
+  SECTION("equal seeds give equal streams, other seeds other streams") {
+    ts::ExplorationConfig noisy;
+    noisy.seed = 9;
+    const auto a = ts::explore_palpation(ts::Sphere(0.04), noisy, {.touches = 5});
+    const auto b = ts::explore_palpation(ts::Sphere(0.04), noisy, {.touches = 5});
+    noisy.seed = 10;
+    const auto c = ts::explore_palpation(ts::Sphere(0.04), noisy, {.touches = 5});
+    const auto ca = a.contacts(), cb = b.contacts(), cc = c.contacts();
+    REQUIRE(ca.size() == cb.size());
+    for (std::size_t i = 0; i < ca.size(); ++i) REQUIRE(ca[i].position == cb[i].position);
+    CHECK((ca.size() != cc.size() || ca[0].position != cc[0].position));
+  }
+}
+
+TEST_CASE("explorations and sensor model refuse bad parameters", "[sim][exploration]") {
+  const ts::Sphere s(0.04);
+  ts::ExplorationConfig cfg;
+  CHECK_THROWS_AS(ts::explore_sliding(s, cfg, {.slides = 0}), std::invalid_argument);
+  CHECK_THROWS_AS(ts::explore_grasps(s, cfg, {.fingers = 0}), std::invalid_argument);
+  CHECK_THROWS_AS(ts::explore_palpation(s, cfg, {.press_speed = 0}), std::invalid_argument);
+  cfg.indentation = std::nan("");
+  CHECK_THROWS_AS(ts::explore_sliding(s, cfg), std::invalid_argument);
+  cfg = {};
+  cfg.sensor.geometry.pitch = -1;
+  CHECK_THROWS_WITH(ts::explore_palpation(s, cfg), Catch::Contains("pitch"));
+  cfg = {};
+  cfg.sensor.threshold = cfg.sensor.levels;
+  CHECK_THROWS_WITH(ts::explore_palpation(s, cfg), Catch::Contains("threshold"));
+  cfg = {};
+  cfg.frame_rate = 0;
+  CHECK_THROWS_WITH(ts::explore_grasps(s, cfg), Catch::Contains("frame_rate"));
+}
