@@ -121,6 +121,38 @@ void study(const char* name, const Shape& shape, std::size_t n, const sim::Slidi
   }
 }
 
+// The tactile pad model (sim/sensor.hpp, sim/exploration.hpp): a DSA-like 14x6 pad slides,
+// a three-finger hand with two pads per finger grasps, and a fingertip pad palpates; the three
+// streams in turn, with contacts per active tactel or one per pad and frame.
+template <class Shape>
+void pad_study(const char* name, const Shape& shape, bool quick, sim::ContactMode mode,
+               bool print_header) {
+  sim::ExplorationConfig cfg;
+  cfg.mode = mode;
+  cfg.seed = 11;
+  const int scale = quick ? 1 : 4;
+  std::vector<Contact<double>> contacts;
+  const auto add = [&](const auto& ex) {
+    const auto part = ex.contacts();
+    contacts.insert(contacts.end(), part.begin(), part.end());
+  };
+  add(sim::explore_sliding(shape, cfg, {.slides = 2 * scale, .frames = 500}));
+  add(sim::explore_grasps(shape, cfg, {.grasps = 4 * scale}));
+  add(sim::explore_palpation(shape, cfg, {.touches = 20 * scale}));
+  if (print_header) {
+    std::printf("%-26s %-10s %8s | %-14s | %-14s | %-14s\n", "shape", "contacts", "",
+                "raw rms/max mm", "average pts/rms", "kalman pts/rms");
+  }
+  constexpr double kGate = 4e-3;  // 4 sigma of the in-plane quantisation (0.98 mm)
+  const Row raw = fuse<tf::Raw<double>>(shape, contacts, contacts.size(), {}, kGate);
+  const Row avg = fuse<tf::Average<double>>(shape, contacts, contacts.size(), {}, kGate);
+  const Row kal = fuse<tf::Kalman<double>>(shape, contacts, contacts.size(), {}, kGate);
+  std::printf("%-26s %-10s %8zu | %6.3f %7.2f | %5zu %8.3f | %5zu %8.3f\n", name,
+              mode == sim::ContactMode::per_tactel ? "per tactel" : "per pad", contacts.size(),
+              1e3 * raw.m.error.rms, 1e3 * raw.m.error.max, avg.m.points, 1e3 * avg.m.error.rms,
+              kal.m.points, 1e3 * kal.m.error.rms);
+}
+
 constexpr const char* kUsage =
     "usage: 02_fusion_study [--quick] [--out DIR]\n"
     "Raw vs Average vs Kalman fusion of simulated explorations of five shapes: points,\n"
@@ -187,6 +219,22 @@ int main(int argc, char** argv) try {
   std::printf("Control: isotropic constant noise (sigma 0.98 mm in every direction, no tilt)\n");
   study("sphere r40 isotropic", sim::Sphere(0.04), n, iso, {}, nullptr, true, false, kRadius);
   std::printf("Theory: with the same isotropic R for every contact, Kalman equals averaging.\n\n");
+
+  std::printf(
+      "Pad model: a 14x6 DSA-like pad at 3.4 mm (12-bit readings, 0.3 mm depth noise, 0.2 mm and "
+      "0.02 rad pose noise) slides, grasps (3 fingers x 2 pads) and palpates; gate 4 mm\n");
+  bool header = true;
+  for (const auto mode : {sim::ContactMode::per_tactel, sim::ContactMode::per_pad}) {
+    pad_study("sphere r40", sim::Sphere(0.04), quick, mode, header);
+    pad_study("cylinder r30 h100", sim::Cylinder(0.03, 0.05), quick, mode, false);
+    pad_study("box 80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02)), quick, mode, false);
+    pad_study("cone r30 h60", sim::Cone(0.03, 0.06), quick, mode, false);
+    pad_study("mesh icosphere r35 (PLY)", mesh, quick, mode, false);
+    header = false;
+  }
+  std::printf(
+      "With a pad's worth of contacts per frame, each fused point gathers hundreds of contacts: "
+      "its error is the bias of fusing a curved patch the size of the gate more than noise.\n\n");
 
   io::LinePlot plot;
   plot.title = "RMS distance to the surface against contacts (sphere r40, anisotropic noise)";

@@ -3,6 +3,7 @@
 // and, optionally, the ground-truth surface as PLY.
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <limits>
@@ -22,22 +23,36 @@ namespace ts = taxel::sim;
 
 constexpr const char* kUsage = R"usage(usage: taxel-simulate [options] CONTACTS.csv [TRUTH.ply]
 
-Slides a simulated tactile pad over a shape (several slides from random starts, a random-walk
-heading) and writes the contacts, with their anisotropic pad covariance, normal and time, as
-CSV for taxel-fuse. TRUTH.ply, when given, gets points sampled uniformly over the true surface
-with their normals. Units: metres, seconds, radians.
+Explores a shape with simulated tactile pads (a Weiss DSA 9205-like 14x6 matrix at 3.4 mm by
+default): sliding, grasps of a multi-finger hand, or palpation. Each pad frame turns indentation
+into 12-bit readings with depth noise; the pose has kinematic noise. Writes the contacts, with
+the anisotropic covariance the noise implies, the normal, pressure and time, as CSV for
+taxel-fuse. TRUTH.ply, when given, gets points sampled uniformly over the true surface (at its
+pose) with their normals. Units: metres, seconds, radians.
 
 options:
   --shape sphere|cylinder|box|cone|mesh   (default sphere)
   --size A[,B[,C]]   sphere: radius (0.04); cylinder: radius, half height (0.03,0.05);
                      box: half extents (0.04,0.03,0.02); cone: radius, height (0.03,0.06)
   --mesh FILE.ply    the mesh of --shape mesh (closed, outward-oriented triangles)
-  --contacts N       contacts to write (default 20000)
-  --slides K         slides from random starts (default 4)
-  --pitch P          tactel pitch (default 0.0034)
-  --sigma-normal S   contact noise along the pad normal (default 0.001)
-  --tilt T           kinematic tilt noise per frame (default 0.05)
+  --pose X,Y,Z[,RX,RY,RZ]  the object's position and rotation vector (default the origin)
+  --exploration sliding|grasp|palpation   (default sliding)
+  --contacts N       stop after N contacts, exploring further as needed (default 20000;
+                     0: exactly the exploration below)
+  --per-pad          one pressure-weighted contact per pad and frame, not one per tactel
+  --slides K         sliding: slides from random starts (default 4)
+  --frames F         sliding: frames per slide (default 1000)
   --speed V          sliding speed [m/s] (default 0.05)
+  --grasps G         grasp: grasps with random axes (default 8)
+  --fingers F        grasp: fingers (default 3), --pads-per-finger P (default 2)
+  --touches T        palpation: touches (default 40)
+  --pad RxC          tactel rows x columns (default 14x6)
+  --pitch P          tactel pitch (default 0.0034)
+  --indentation D    how far pads press in (default 0.001)
+  --sigma-normal S   depth noise along the pad normal (default 0.0003)
+  --sigma-position S kinematic translation noise (default 0.0002)
+  --tilt T           kinematic rotation noise (default 0.02)
+  --frame-rate HZ    (default 1000)
   --seed S           (default 1)
   --truth-points N   samples of the true surface in TRUTH.ply (default 10000)
   -h, --help         show this help
@@ -49,14 +64,18 @@ struct Options {
   std::string shape = "sphere";
   std::vector<double> size;
   std::string mesh;
+  std::string exploration = "sliding";
   std::size_t contacts = 20000;
-  int slides = 4;
-  ts::SlidingConfig sliding;
+  ts::ExplorationConfig config;
+  ts::SlideParams slide;
+  ts::GraspParams grasp;
+  ts::PalpationParams palpation;
   std::size_t truth_points = 10000;
   std::vector<std::string> files;
 };
 
-std::vector<double> numbers(const taxel_cli::Args& args, std::string_view text) {
+std::vector<double> numbers(const taxel_cli::Args& args, std::string_view option,
+                            std::string_view text) {
   std::vector<double> out;
   std::size_t p = 0;
   while (p <= text.size()) {
@@ -64,8 +83,11 @@ std::vector<double> numbers(const taxel_cli::Args& args, std::string_view text) 
     const std::string_view tok = text.substr(p, e - p);
     double v = 0.0;
     const auto res = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-    if (tok.empty() || res.ec != std::errc() || res.ptr != tok.data() + tok.size()) {
-      args.fail("--size: '" + std::string(tok) + "' is not a number");
+    if (tok.empty() || res.ec != std::errc() || res.ptr != tok.data() + tok.size() ||
+        !std::isfinite(v)) {
+      std::string why(option);
+      why.append(": '").append(tok).append("' is not a finite number");
+      args.fail(why);
     }
     out.push_back(v);
     p = e + 1;
@@ -73,28 +95,54 @@ std::vector<double> numbers(const taxel_cli::Args& args, std::string_view text) 
   return out;
 }
 
+// The exploration, grown (more frames, grasps or touches) until it holds `want` contacts.
+template <class Shape>
+ts::Exploration<Shape> explore(const Options& o, const Shape& shape, std::size_t want) {
+  const auto once = [&](std::size_t scale) {
+    if (o.exploration == "sliding") {
+      ts::SlideParams p = o.slide;
+      p.frames *= scale;
+      return ts::explore_sliding(shape, o.config, p);
+    }
+    if (o.exploration == "grasp") {
+      ts::GraspParams p = o.grasp;
+      p.grasps *= static_cast<int>(scale);
+      return ts::explore_grasps(shape, o.config, p);
+    }
+    ts::PalpationParams p = o.palpation;
+    p.touches *= static_cast<int>(scale);
+    return ts::explore_palpation(shape, o.config, p);
+  };
+  for (std::size_t scale = 1;; scale *= 2) {
+    ts::Exploration<Shape> ex = once(scale);
+    if (ex.contact_count() >= want || scale >= 64) return ex;
+  }
+}
+
 template <class Shape>
 int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
-  std::vector<taxel::Contact<double>> contacts;
-  contacts.reserve(o.contacts);
-  for (int s = 0; s < o.slides; ++s) {
-    ts::SlidingConfig c = o.sliding;
-    c.seed = o.sliding.seed * 7919 + static_cast<std::uint64_t>(s);
-    const std::size_t left = o.contacts - contacts.size();
-    const std::size_t n =
-        s + 1 == o.slides ? left : std::min(left, o.contacts / static_cast<std::size_t>(o.slides));
-    const auto part = ts::sliding_exploration(shape, n, c);
-    contacts.insert(contacts.end(), part.begin(), part.end());
+  const ts::Exploration<Shape> ex = explore(o, shape, o.contacts);
+  std::vector<taxel::Contact<double>> contacts = ex.contacts();
+  if (o.contacts > 0 && contacts.size() > o.contacts) contacts.resize(o.contacts);
+  if (contacts.size() < o.contacts) {
+    args.fail("the exploration touched the shape too rarely for " + std::to_string(o.contacts) +
+              " contacts (got " + std::to_string(contacts.size()) + ")");
   }
   try {
     taxel::io::write_contacts_csv(o.files[0], contacts);
     if (o.files.size() > 1) {
-      taxel::io::write_ply(o.files[1], ts::sample_surface(shape, o.truth_points, o.sliding.seed));
+      taxel::io::write_ply(o.files[1], ts::sample_surface(ex.truth, o.truth_points, o.config.seed));
     }
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }
-  std::printf("shape %s\ncontacts %zu\nslides %d\n", o.shape.c_str(), contacts.size(), o.slides);
+  std::size_t frames = 0;
+  for (const auto& f : ex.frames) {
+    if (!contacts.empty() && f.time > contacts.back().time) break;
+    ++frames;
+  }
+  std::printf("shape %s\nexploration %s\ncontacts %zu\nframes %zu\n", o.shape.c_str(),
+              o.exploration.c_str(), contacts.size(), frames);
   return 0;
 }
 
@@ -104,6 +152,7 @@ int main(int argc, char** argv) {
   taxel_cli::Args args("taxel-simulate", argc, argv);
   constexpr double kInf = std::numeric_limits<double>::infinity();
   Options o;
+  taxel::sim::SensorModel& sensor = o.config.sensor;
   std::string_view a;
   while (args.next(a)) {
     if (a == "-h" || a == "--help") {
@@ -116,23 +165,68 @@ int main(int argc, char** argv) {
         args.fail("--shape must be sphere, cylinder, box, cone or mesh");
       }
     } else if (a == "--size") {
-      o.size = numbers(args, args.value());
+      o.size = numbers(args, "--size", args.value());
     } else if (a == "--mesh") {
       o.mesh = std::string(args.value());
+    } else if (a == "--pose") {
+      const std::vector<double> v = numbers(args, "--pose", args.value());
+      if (v.size() != 3 && v.size() != 6) args.fail("--pose takes 3 or 6 numbers");
+      o.config.object_pose.translation() = taxel::Vec3d(v[0], v[1], v[2]);
+      if (v.size() == 6) {
+        const taxel::Vec3d r(v[3], v[4], v[5]);
+        if (r.norm() > 0)
+          o.config.object_pose.linear() = Eigen::AngleAxisd(r.norm(), r.normalized()).matrix();
+      }
+    } else if (a == "--exploration") {
+      o.exploration = std::string(args.value());
+      if (o.exploration != "sliding" && o.exploration != "grasp" && o.exploration != "palpation")
+        args.fail("--exploration must be sliding, grasp or palpation");
     } else if (a == "--contacts") {
-      o.contacts = args.number<std::size_t>(1, std::size_t{1} << 26);
+      o.contacts = args.number<std::size_t>(0, std::size_t{1} << 26);
+    } else if (a == "--per-pad") {
+      o.config.mode = ts::ContactMode::per_pad;
     } else if (a == "--slides") {
-      o.slides = args.number<int>(1, 10000);
-    } else if (a == "--pitch") {
-      o.sliding.pitch = args.number<double>(-kInf, kInf);
-    } else if (a == "--sigma-normal") {
-      o.sliding.sigma_normal = args.number<double>(-kInf, kInf);
-    } else if (a == "--tilt") {
-      o.sliding.sigma_tilt = args.number<double>(-kInf, kInf);
+      o.slide.slides = args.number<int>(1, 10000);
+    } else if (a == "--frames") {
+      o.slide.frames = args.number<std::size_t>(1, std::size_t{1} << 24);
     } else if (a == "--speed") {
-      o.sliding.speed = args.number<double>(-kInf, kInf);
+      o.slide.speed = args.number<double>(0, 10);
+    } else if (a == "--grasps") {
+      o.grasp.grasps = args.number<int>(1, 100000);
+    } else if (a == "--fingers") {
+      o.grasp.fingers = args.number<int>(1, 64);
+    } else if (a == "--pads-per-finger") {
+      o.grasp.pads_per_finger = args.number<int>(1, 64);
+    } else if (a == "--touches") {
+      o.palpation.touches = args.number<int>(1, 1000000);
+    } else if (a == "--pad") {
+      const std::string_view v = args.value();
+      const std::size_t x = v.find('x');
+      int r = 0, c = 0;
+      const auto r1 = std::from_chars(v.data(), v.data() + std::min(x, v.size()), r);
+      const auto r2 = x == std::string_view::npos
+                          ? std::from_chars_result{v.data(), std::errc::invalid_argument}
+                          : std::from_chars(v.data() + x + 1, v.data() + v.size(), c);
+      if (r1.ec != std::errc() || r2.ec != std::errc() || r1.ptr != v.data() + x ||
+          r2.ptr != v.data() + v.size() || r < 1 || c < 1 || r > 256 || c > 256) {
+        args.fail("--pad takes ROWSxCOLS, each in [1, 256], e.g. 14x6");
+      }
+      sensor.geometry.rows = r;
+      sensor.geometry.cols = c;
+    } else if (a == "--pitch") {
+      sensor.geometry.pitch = args.number<double>(-kInf, kInf);
+    } else if (a == "--indentation") {
+      o.config.indentation = args.number<double>(-kInf, kInf);
+    } else if (a == "--sigma-normal") {
+      sensor.sigma_normal = args.number<double>(-kInf, kInf);
+    } else if (a == "--sigma-position") {
+      sensor.sigma_position = args.number<double>(-kInf, kInf);
+    } else if (a == "--tilt") {
+      sensor.sigma_tilt = args.number<double>(-kInf, kInf);
+    } else if (a == "--frame-rate") {
+      o.config.frame_rate = args.number<double>(-kInf, kInf);
     } else if (a == "--seed") {
-      o.sliding.seed = args.number<std::uint64_t>(0, std::numeric_limits<std::uint64_t>::max());
+      o.config.seed = args.number<std::uint64_t>(0, std::numeric_limits<std::uint64_t>::max());
     } else if (a == "--truth-points") {
       o.truth_points = args.number<std::size_t>(1, std::size_t{1} << 26);
     } else if (a.size() > 1 && a[0] == '-') {
@@ -154,6 +248,7 @@ int main(int argc, char** argv) {
     return o.size;
   };
   try {
+    o.config.validate();
     if (o.shape == "sphere") return run(o, ts::Sphere(dims(1, {0.04})[0]), args);
     if (o.shape == "cylinder") {
       const auto d = dims(2, {0.03, 0.05});
