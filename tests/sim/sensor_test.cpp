@@ -32,7 +32,7 @@ Eigen::Isometry3d on_box_top(double depth, double x = 0.0, double y = 0.0) {
 
 }  // namespace
 
-TEST_CASE("pad readings follow the indentation; contacts lie on the pressed surface",
+TEST_CASE("pad readings follow the indentation, contacts lie on the pressed surface",
           "[sim][sensor]") {
   const ts::Box box;
   ts::SensorModel m = noiseless();
@@ -98,7 +98,7 @@ TEST_CASE("pad readings follow the indentation; contacts lie on the pressed surf
   }
 }
 
-TEST_CASE("pad on a sphere: contacts within the curvature error of the surface", "[sim][sensor]") {
+TEST_CASE("pad on a sphere: contacts on the surface", "[sim][sensor]") {
   const ts::Sphere sphere(0.04);
   const ts::SensorModel m = noiseless();
   std::mt19937_64 rng(2);
