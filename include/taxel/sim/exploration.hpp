@@ -85,8 +85,9 @@ struct SlideParams {
 /// Grasps of a hand with `fingers` fingers evenly spread around a random grasp axis, each with
 /// `pads_per_finger` pads along it `pad_spacing` apart. Each finger closes straight towards the
 /// axis at `closing_speed` and stops `indentation` past its first touch (a compliant,
-/// position-controlled hand); then the hand holds for `hold_frames` frames and lets go. Pads that
-/// touch nothing within the object's reach are left out of the grasp's frames.
+/// position-controlled hand); then the hand holds for `hold_frames` frames and lets go. Every
+/// frame has one reading per pad, `pad` = finger * pads_per_finger + pad on the finger; a pad
+/// whose path misses the object stays open and reads nothing.
 struct GraspParams {
   int grasps = 8;               ///< grasps with random axes, >= 1
   int fingers = 3;              ///< >= 1 (an SDH-2 has 3)
@@ -253,18 +254,20 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
           }
           lo = s;
         }
-        if (pad.touch >= 0.0) pads.push_back(pad);
+        pads.push_back(pad);
       }
     }
-    if (pads.empty()) continue;
+    if (std::none_of(pads.begin(), pads.end(), [](const Pad& q) { return q.touch >= 0.0; }))
+      continue;
     const int closing = static_cast<int>(std::ceil(cfg.indentation / step)) + 2;
     for (int f = 0; f < closing + p.hold_frames; ++f, ++tick) {
       const double s_rel = std::min(double(f - 2) * step, cfg.indentation);
       std::vector<PadReading> readings;
       for (std::size_t i = 0; i < pads.size(); ++i) {
         const Pad& pad = pads[i];
+        const double s = pad.touch >= 0.0 ? pad.touch + s_rel : 0.0;  // a miss stays open
         const Eigen::Isometry3d pose =
-            detail::pad_pose(pad.inward, axis, pad.origin + (pad.touch + s_rel) * pad.inward);
+            detail::pad_pose(pad.inward, axis, pad.origin + s * pad.inward);
         readings.push_back(read_pad(world, cfg.sensor, pose, rng, static_cast<int>(i)));
       }
       detail::add_frame(ex, cfg, double(tick) / cfg.frame_rate, std::move(readings));
