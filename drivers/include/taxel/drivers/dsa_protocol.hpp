@@ -29,11 +29,11 @@ static_assert(std::endian::native == std::endian::little,
 
 /// Packet ids used by taxel (dsa.cpp's eDSAPacketID).
 enum class PacketId : std::uint8_t {
-  frame = 0x00,             ///< a full tactile frame (pushed while streaming)
-  controller_info = 0x01,   ///< query controller configuration
-  sensor_info = 0x02,       ///< query sensor configuration
-  acquisition = 0x03,       ///< configure data acquisition (frame rate, RLE, start/stop)
-  matrix_info = 0x0B,       ///< query one matrix's configuration
+  frame = 0x00,            ///< a full tactile frame (pushed while streaming)
+  controller_info = 0x01,  ///< query controller configuration
+  sensor_info = 0x02,      ///< query sensor configuration
+  acquisition = 0x03,      ///< configure data acquisition (frame rate, RLE, start/stop)
+  matrix_info = 0x0B,      ///< query one matrix's configuration
 };
 
 /// A protocol violation: malformed or unexpected bytes. The message says what and where.
@@ -80,8 +80,13 @@ struct Packet {
 /// empty). Throws std::length_error for a payload over 65535 bytes.
 inline std::vector<std::uint8_t> encode_packet(std::uint8_t id,
                                                std::span<const std::uint8_t> payload) {
-  if (payload.size() > 0xFFFF) throw std::length_error("dsa::encode_packet: payload over 65535 bytes");
-  std::vector<std::uint8_t> out{0xAA, 0xAA, 0xAA, id, static_cast<std::uint8_t>(payload.size()),
+  if (payload.size() > 0xFFFF)
+    throw std::length_error("dsa::encode_packet: payload over 65535 bytes");
+  std::vector<std::uint8_t> out{0xAA,
+                                0xAA,
+                                0xAA,
+                                id,
+                                static_cast<std::uint8_t>(payload.size()),
                                 static_cast<std::uint8_t>(payload.size() >> 8)};
   out.insert(out.end(), payload.begin(), payload.end());
   if (!payload.empty()) {
@@ -205,8 +210,8 @@ class Parser {
           continue;
         }
       }
-      ready_.push_back(Packet{all[3], std::vector<std::uint8_t>(all.begin() + 6,
-                                                                all.begin() + 6 + long(size))});
+      ready_.push_back(
+          Packet{all[3], std::vector<std::uint8_t>(all.begin() + 6, all.begin() + 6 + long(size))});
       ++stats_.packets;
       pos_ += total;
     }

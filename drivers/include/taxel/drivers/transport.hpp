@@ -3,9 +3,10 @@
 // for tests and emulators.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <concepts>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -47,10 +48,10 @@ using Timeout = std::chrono::milliseconds;
 template <class T>
 concept Transport = requires(T& t, std::span<const std::uint8_t> out, std::span<std::uint8_t> in,
                              Timeout timeout) {
-  { t.open() };
-  { t.close() };
+  {t.open()};
+  {t.close()};
   { t.is_open() } -> std::convertible_to<bool>;
-  { t.write(out, timeout) };
+  {t.write(out, timeout)};
   { t.read(in, timeout) } -> std::same_as<std::size_t>;
 };
 
