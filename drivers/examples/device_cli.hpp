@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+// Shared by the driver tools: pad poses per frame (CSV), static poses from the controller's
+// matrix info, and the simulated hand that drives the emulated controller.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <taxel/drivers/dsa_protocol.hpp>
+#include <taxel/drivers/dsacon_emulator.hpp>
+#include <taxel/sim.hpp>
+#include <vector>
+
+namespace taxel_drivers_cli {
+
+namespace dsa = taxel::drivers::dsa;
+using Poses = std::vector<Eigen::Isometry3d>;
+
+/// Pad poses of each frame, keyed by the controller's time stamp [ms]. CSV with header
+/// `time_ms,matrix,x,y,z,qw,qx,qy,qz` (metres; unit quaternion pad -> world).
+/// Within a frame the rows run over the matrices in order, 0, 1, 2, ...
+inline std::map<std::uint32_t, Poses> read_poses_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::string line;
+  std::size_t line_no = 1;
+  if (!std::getline(in, line) || line != "time_ms,matrix,x,y,z,qw,qx,qy,qz") {
+    throw std::runtime_error(path + ":1: expected the header time_ms,matrix,x,y,z,qw,qx,qy,qz");
+  }
+  std::map<std::uint32_t, Poses> out;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty()) continue;
+    std::istringstream ss(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(ss, cell, ',')) {
+      char* end = nullptr;
+      const double x = std::strtod(cell.c_str(), &end);
+      if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(x)) {
+        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": '" + cell +
+                                 "' is not a finite number");
+      }
+      v.push_back(x);
+    }
+    if (v.size() != 9) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": " +
+                               std::to_string(v.size()) + " values, expected 9");
+    }
+    const Eigen::Quaterniond q(v[5], v[6], v[7], v[8]);
+    if (v[0] < 0 || v[0] > 4294967295.0 || std::abs(q.norm() - 1.0) > 1e-6) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) +
+                               ": time_ms must be a u32 and the quaternion of unit length");
+    }
+    Poses& p = out[static_cast<std::uint32_t>(v[0])];
+    if (v[1] != double(p.size())) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": matrix " +
+                               std::to_string(v[1]) + ", expected " + std::to_string(p.size()) +
+                               " (a frame's rows run over the matrices in order)");
+    }
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = q.toRotationMatrix();
+    T.translation() = taxel::Vec3d(v[2], v[3], v[4]);
+    p.push_back(T);
+  }
+  return out;
+}
+
+/// Writes poses in the format read_poses_csv reads.
+inline void write_poses_csv(const std::string& path, const std::map<std::uint32_t, Poses>& poses) {
+  std::ofstream out(path);
+  out << "time_ms,matrix,x,y,z,qw,qx,qy,qz\n";
+  out.precision(9);
+  for (const auto& [t, ps] : poses) {
+    for (std::size_t i = 0; i < ps.size(); ++i) {
+      const Eigen::Quaterniond q(ps[i].linear());
+      const auto& x = ps[i].translation();
+      out << t << ',' << i << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << q.w() << ','
+          << q.x() << ',' << q.y() << ',' << q.z() << '\n';
+    }
+  }
+  if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+/// Fixed pad poses from the matrix info (centre in mm, angles in rad, rotation
+/// Rz * Ry * Rx): where the controller says each matrix sits in the hand frame.
+inline Poses static_poses(const std::vector<dsa::MatrixInfo>& matrices) {
+  Poses out;
+  for (const auto& m : matrices) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = (Eigen::AngleAxisd(m.theta[2], taxel::Vec3d::UnitZ()) *
+                  Eigen::AngleAxisd(m.theta[1], taxel::Vec3d::UnitY()) *
+                  Eigen::AngleAxisd(m.theta[0], taxel::Vec3d::UnitX()))
+                     .toRotationMatrix();
+    T.translation() = 1e-3 * taxel::Vec3d(m.center[0], m.center[1], m.center[2]);
+    out.push_back(T);
+  }
+  return out;
+}
+
+/// A simulated three-finger hand (two 14x6 pads per finger) grasping a shape: the frames the
+/// emulated controller streams, and the poses forward kinematics would report.
+struct SimulatedHand {
+  std::vector<std::vector<std::uint16_t>> frames;  ///< tactels of each frame, pad after pad
+  std::map<std::uint32_t, Poses> poses;            ///< believed pad poses by time stamp
+  std::vector<dsa::MatrixInfo> matrices;           ///< six 14x6 matrices at 3.4 mm
+};
+
+template <class Shape>
+SimulatedHand simulate_hand(const Shape& shape, int grasps, double period_ms, std::uint64_t seed) {
+  taxel::sim::ExplorationConfig cfg;
+  cfg.frame_rate = 1000.0 / period_ms;
+  cfg.seed = seed;
+  taxel::sim::GraspParams g;
+  g.grasps = grasps;
+  g.closing_speed = 0.01;
+  g.hold_frames = 8;
+  const auto ex = taxel::sim::explore_grasps(shape, cfg, g);
+  SimulatedHand hand;
+  for (int i = 0; i < g.fingers * g.pads_per_finger; ++i) {
+    dsa::MatrixInfo m;
+    m.texel_width = m.texel_height = float(cfg.sensor.geometry.pitch * 1e3);
+    m.cells_x = static_cast<std::uint16_t>(cfg.sensor.geometry.cols);
+    m.cells_y = static_cast<std::uint16_t>(cfg.sensor.geometry.rows);
+    m.fullscale = float(cfg.sensor.levels - 1);
+    m.uid = {0x54, 0x58, 0x4c, 0x00, std::uint8_t(i), 0x01};
+    hand.matrices.push_back(m);
+  }
+  for (std::size_t f = 0; f < ex.frames.size(); ++f) {
+    std::vector<std::uint16_t> texels;
+    Poses poses;
+    for (const auto& pad : ex.frames[f].pads) {
+      texels.insert(texels.end(), pad.counts.data(), pad.counts.data() + pad.counts.size());
+      poses.push_back(pad.believed_pose);
+    }
+    hand.frames.push_back(std::move(texels));
+    // The emulator stamps frame i with round(i * period) ms.
+    hand.poses[static_cast<std::uint32_t>(double(f) * period_ms + 0.5)] = std::move(poses);
+  }
+  return hand;
+}
+
+}  // namespace taxel_drivers_cli

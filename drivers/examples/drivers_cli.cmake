@@ -1,0 +1,48 @@
+# SPDX-License-Identifier: MIT
+# CLI test of taxel-record and 07_stream_fusion: help, bad options, a session recorded through
+# the emulated controller and replayed into fusion, the committed session, and refusals.
+include(${CMAKE_CURRENT_LIST_DIR}/../../examples/tests/cli_common.cmake)
+
+run_tool("${RECORD}" 0 --help)
+expect("${out}" "usage: taxel-record")
+run_tool("${RECORD}" 2 s.session)
+expect("${err}" "give exactly one of --serial, --usb, --usb-bus, --emulate")
+expect_one_line("${err}")
+run_tool("${RECORD}" 2 --usb 12345 s.session)
+expect("${err}" "--usb: '12345' is not of the form A:B")
+run_tool("${RECORD}" 2 --emulate torus s.session)
+expect("${err}" "--emulate takes sphere, cylinder or box")
+run_tool("${RECORD}" 2 --serial /dev/null --poses p.csv s.session)
+expect("${err}" "--poses needs --emulate")
+run_tool("${RECORD}" 1 --serial /nonexistent/ttyDSA s.session)
+expect("${err}" "/nonexistent/ttyDSA: cannot open")
+expect_one_line("${err}")
+
+# Record a simulated sphere grasp through the emulated controller, then replay it into fusion.
+run_tool("${RECORD}" 0 --emulate sphere --grasps 2 --period-ms 5 --poses p.csv s.session)
+expect("${out}" "matrices 6\ntactels 504\nframes 60\ndropped 0\ncrc errors 0\n")
+run_tool("${STREAM}" 0 --replay s.session --poses p.csv --out out)
+expect("${out}" "frames 60 \\(dropped 0, bad 0, with poses 60\\)")
+expect("${out}" "contacts [1-9][0-9]* -> fused points [1-9]")
+if(NOT EXISTS "${WORK_DIR}/out/cloud.ply")
+  message(FATAL_ERROR "07_stream_fusion wrote no cloud.ply")
+endif()
+run_tool("${STREAM}" 0 --replay s.session --poses p.csv --per-pad --out out)
+expect("${out}" "contacts [1-9][0-9]* -> fused points")
+
+# The committed session (README, demo) still replays.
+run_tool("${STREAM}" 0 --replay ${SESSION_DIR}/cylinder_grasp.session
+         --poses ${SESSION_DIR}/cylinder_grasp_poses.csv --out out2)
+expect("${out}" "frames 78 \\(dropped 0, bad 0, with poses 78\\)")
+
+# Refusals: a malformed session names its line; a host that departs from the recording is caught.
+file(WRITE "${WORK_DIR}/bad.session" "taxel-session 1\n0.0 > aaaaaa0g\n")
+run_tool("${STREAM}" 1 --replay bad.session)
+expect("${err}" "bad.session:2: 'g' at column 14 is not a hex digit")
+expect_one_line("${err}")
+file(WRITE "${WORK_DIR}/other.session" "taxel-session 1\n0.0 > aaaaaa020000\n")
+run_tool("${STREAM}" 1 --replay other.session)
+expect("${err}" "differs from the recording at chunk 1, byte 3")
+file(WRITE "${WORK_DIR}/bad_poses.csv" "time_ms,matrix,x,y,z,qw,qx,qy,qz\n0,1,0,0,0,1,0,0,0\n")
+run_tool("${STREAM}" 1 --replay s.session --poses bad_poses.csv)
+expect("${err}" "bad_poses.csv:2: matrix 1.000000, expected 0")

@@ -1,0 +1,216 @@
+// SPDX-License-Identifier: MIT
+// taxel-record: records a DSACON32m session (every byte both ways, time-stamped) from a serial
+// port, a USB device, or the emulated controller fed by a simulated grasp.
+#include <atomic>
+#include <charconv>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <taxel/drivers/dsacon_device.hpp>
+#include <taxel/drivers/dsacon_emulator.hpp>
+#include <taxel/drivers/serial.hpp>
+#include <taxel/drivers/session.hpp>
+#include <taxel/drivers/usb.hpp>
+#include <thread>
+
+#include "../../examples/cli.hpp"
+#include "device_cli.hpp"
+
+namespace {
+
+namespace td = taxel::drivers;
+namespace cli = taxel_drivers_cli;
+
+constexpr const char* kUsage = R"usage(usage: taxel-record [options] SESSION.txt
+
+Opens a DSACON32m tactile controller, streams frames and records the whole conversation (every
+byte both ways, time-stamped) to SESSION.txt, which ReplayTransport and 07_stream_fusion play
+back without hardware.
+
+source (one):
+  --serial DEVICE    a serial port, e.g. /dev/ttyUSB0 (115200 baud unless --baud)
+  --usb VID:PID      a USB device with bulk IN/OUT endpoints (hex ids), e.g. 0403:6001
+  --usb-bus BUS:ADDR the same, by bus number and device address (decimal)
+  --emulate SHAPE    the software controller, streaming a simulated three-finger hand grasping
+                     sphere, cylinder or box (no hardware)
+options:
+  --frames N         frames to record (default 100; with --emulate, every simulated frame)
+  --baud B           serial baud rate (default 115200)
+  --timeout MS       reply and frame timeout (default 1000)
+  --poses FILE.csv   with --emulate: write the pads' poses per frame (for 07_stream_fusion)
+  --grasps G         with --emulate: grasps to simulate (default 8)
+  --period-ms P      with --emulate: frame period (default 33.3, about 30 frames/s)
+  --seed S           with --emulate (default 1)
+  -h, --help         show this help
+
+Exit status: 0 on success, 1 when the device fails or a file cannot be written, 2 for bad
+options.
+)usage";
+
+struct Options {
+  std::string serial, usb, usb_bus, emulate, poses, out;
+  unsigned baud = 115200;
+  int frames = -1, grasps = 8;  // frames: 100 from a device, every simulated one emulated
+  double period_ms = 1000.0 / 30.0;
+  long timeout_ms = 1000;
+  std::uint64_t seed = 1;
+};
+
+template <class T>
+int record(T transport, const Options& o, const taxel_cli::Args& args) {
+  td::DsaconDevice dev(
+      td::RecordingTransport<T>(std::move(transport)),
+      {.reply_timeout = td::Timeout(o.timeout_ms), .frame_timeout = td::Timeout(o.timeout_ms)});
+  int got = 0;
+  try {
+    dev.open();
+    dev.start();
+    for (; got < o.frames; ++got) {
+      if (!dev.read_frame()) {
+        args.fail("no frame within " + std::to_string(o.timeout_ms) + " ms after " +
+                      std::to_string(got) + " frames",
+                  1);
+      }
+    }
+    dev.stop();
+    dev.close();
+    td::write_session(o.out, dev.transport().chunks());
+  } catch (const std::exception& e) {
+    args.fail(e.what(), 1);
+  }
+  const auto s = dev.stats();
+  std::size_t bytes = 0;
+  for (const auto& c : dev.transport().chunks()) bytes += c.bytes.size();
+  std::printf("controller sw %u serial %u\nmatrices %zu\ntactels %zu\nframes %d\n",
+              unsigned(dev.controller_info().sw_version), unsigned(dev.controller_info().serial_no),
+              dev.matrices().size(), dev.cells(), got);
+  std::printf("dropped %llu\ncrc errors %zu\nbytes %zu\nwrote %s\n",
+              static_cast<unsigned long long>(s.dropped_frames), s.link.crc_errors, bytes,
+              o.out.c_str());
+  return 0;
+}
+
+template <class Shape>
+int emulate(const Shape& shape, const Options& o, const taxel_cli::Args& args) {
+  const cli::SimulatedHand hand = cli::simulate_hand(shape, o.grasps, o.period_ms, o.seed);
+  Options with_frames = o;
+  if (with_frames.frames < 0) with_frames.frames = static_cast<int>(hand.frames.size());
+  td::EmulatorConfig cfg;
+  cfg.matrices = hand.matrices;
+  cfg.period_ms = o.period_ms;
+  const std::size_t cells = hand.frames.empty() ? 0 : hand.frames[0].size();
+  td::DsaconEmulator emulator(cfg, [&](std::uint64_t i) {
+    return i < hand.frames.size() ? hand.frames[i] : std::vector<std::uint16_t>(cells, 0);
+  });
+  auto [host, device] = td::LoopbackTransport::pair();
+  device.open();
+  std::atomic<bool> stop{false};
+  std::thread controller([&] { emulator.serve(device, stop, true); });
+  int rc = 1;
+  try {
+    rc = record(std::move(host), with_frames, args);
+  } catch (...) {
+    stop = true;
+    controller.join();
+    throw;
+  }
+  stop = true;
+  controller.join();
+  if (!o.poses.empty()) {
+    try {
+      cli::write_poses_csv(o.poses, hand.poses);
+    } catch (const std::exception& e) {
+      args.fail(e.what(), 1);
+    }
+    std::printf("wrote %s\n", o.poses.c_str());
+  }
+  return rc;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  taxel_cli::Args args("taxel-record", argc, argv);
+  Options o;
+  std::string_view a;
+  while (args.next(a)) {
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--serial") {
+      o.serial = std::string(args.value());
+    } else if (a == "--usb") {
+      o.usb = std::string(args.value());
+    } else if (a == "--usb-bus") {
+      o.usb_bus = std::string(args.value());
+    } else if (a == "--emulate") {
+      o.emulate = std::string(args.value());
+      if (o.emulate != "sphere" && o.emulate != "cylinder" && o.emulate != "box")
+        args.fail("--emulate takes sphere, cylinder or box");
+    } else if (a == "--frames") {
+      o.frames = args.number<int>(1, 10000000);
+    } else if (a == "--baud") {
+      o.baud = args.number<unsigned>(1, 4000000);
+    } else if (a == "--timeout") {
+      o.timeout_ms = args.number<long>(1, 600000);
+    } else if (a == "--poses") {
+      o.poses = std::string(args.value());
+    } else if (a == "--grasps") {
+      o.grasps = args.number<int>(1, 10000);
+    } else if (a == "--period-ms") {
+      o.period_ms = args.number<double>(1.0, 10000.0);
+    } else if (a == "--seed") {
+      o.seed = args.number<std::uint64_t>(0, std::numeric_limits<std::uint64_t>::max());
+    } else if (a.size() > 1 && a[0] == '-') {
+      args.fail("unknown option '" + std::string(a) + "' (see --help)");
+    } else if (o.out.empty()) {
+      o.out = std::string(a);
+    } else {
+      args.fail("expected one SESSION.txt (see --help)");
+    }
+  }
+  if (o.out.empty()) args.fail("expected SESSION.txt (see --help)");
+  const int sources = int(!o.serial.empty()) + int(!o.usb.empty()) + int(!o.usb_bus.empty()) +
+                      int(!o.emulate.empty());
+  if (sources != 1) args.fail("give exactly one of --serial, --usb, --usb-bus, --emulate");
+  if (!o.poses.empty() && o.emulate.empty()) args.fail("--poses needs --emulate");
+  // "A:B" as two numbers in `base`.
+  const auto pair = [&](const std::string& text, int base, const char* what) {
+    const std::size_t colon = text.find(':');
+    unsigned x = 0, y = 0;
+    const char* end = text.data() + text.size();
+    const auto r1 =
+        std::from_chars(text.data(), text.data() + std::min(colon, text.size()), x, base);
+    const auto r2 = colon == std::string::npos
+                        ? std::from_chars_result{end, std::errc::invalid_argument}
+                        : std::from_chars(text.data() + colon + 1, end, y, base);
+    if (r1.ec != std::errc() || r2.ec != std::errc() || r1.ptr != text.data() + colon ||
+        r2.ptr != end || x > 0xFFFF || y > 0xFFFF) {
+      args.fail(std::string(what) + ": '" + text + "' is not of the form A:B");
+    }
+    return std::pair<unsigned, unsigned>(x, y);
+  };
+  if (o.frames < 0 && o.emulate.empty()) o.frames = 100;
+  try {
+    if (!o.serial.empty()) return record(td::SerialTransport(o.serial, o.baud), o, args);
+    if (!o.usb.empty()) {
+      const auto [vid, pid] = pair(o.usb, 16, "--usb");
+      return record(
+          td::UsbTransport({.vendor_id = std::uint16_t(vid), .product_id = std::uint16_t(pid)}), o,
+          args);
+    }
+    if (!o.usb_bus.empty()) {
+      const auto [bus, addr] = pair(o.usb_bus, 10, "--usb-bus");
+      if (bus > 255 || addr > 255) args.fail("--usb-bus: bus and address are at most 255");
+      return record(td::UsbTransport({.bus = std::uint8_t(bus), .address = std::uint8_t(addr)}), o,
+                    args);
+    }
+    if (o.emulate == "sphere") return emulate(taxel::sim::Sphere(0.04), o, args);
+    if (o.emulate == "cylinder") return emulate(taxel::sim::Cylinder(0.03, 0.05), o, args);
+    return emulate(taxel::sim::Box(taxel::Vec3d(0.04, 0.03, 0.02)), o, args);
+  } catch (const std::exception& e) {
+    args.fail(e.what(), 1);
+  }
+}
