@@ -7,6 +7,9 @@ set(TAXEL_INSTALL_CMAKEDIR "${CMAKE_INSTALL_DATADIR}/cmake/taxel"
 
 install(DIRECTORY include/taxel DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.hpp")
+# The driver headers too: taxelConfig.cmake defines taxel::drivers where libusb-1.0 is found.
+install(DIRECTORY drivers/include/taxel DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+        FILES_MATCHING PATTERN "*.hpp")
 install(TARGETS taxel EXPORT taxelTargets)
 install(EXPORT taxelTargets NAMESPACE taxel:: DESTINATION ${TAXEL_INSTALL_CMAKEDIR})
 

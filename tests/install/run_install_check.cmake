@@ -33,7 +33,13 @@ foreach(kind cmake pkgconfig subdir)
       "-DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER}" -DCMAKE_BUILD_TYPE=Release)
   run(${CMAKE_COMMAND} --build "${build}")
   run("${build}/consumer")
+  if(EXISTS "${build}/consumer_drivers")
+    run("${build}/consumer_drivers")
+  endif()
 endforeach()
+if(NOT EXISTS "${WORK_DIR}/build_cmake/consumer_drivers" AND NOT NO_DRIVERS)
+  message(FATAL_ERROR "the installed package defined no taxel::drivers although libusb is here")
+endif()
 
 # The package config must come from the prefix, not from the source or build tree.
 file(READ "${WORK_DIR}/build_cmake/CMakeCache.txt" cache)
