@@ -31,7 +31,7 @@ back without hardware.
 
 source (one):
   --serial DEVICE    a serial port, e.g. /dev/ttyUSB0 (115200 baud unless --baud)
-  --usb VID:PID      a USB device with bulk IN/OUT endpoints (hex ids), e.g. 0403:6001
+  --usb VID:PID      a USB device with bulk IN/OUT endpoints (hex ids, e.g. 1234:5678)
   --usb-bus BUS:ADDR the same, by bus number and device address (decimal)
   --emulate SHAPE    the software controller, streaming a simulated three-finger hand grasping
                      sphere, cylinder or box (no hardware)
