@@ -1,102 +1,514 @@
 // SPDX-License-Identifier: MIT
-// taxel-demo: the end-to-end demonstration of what taxel does so far. It grows with each
-// capability. Today: contact-stream fusion of simulated sliding explorations with the three
-// policies, the accuracy/compaction table, and the fused clouds written as ASCII PLY.
-//   taxel-demo [--quick] [output-folder]
+// taxel-demo: everything taxel does, end to end, on simulated data, into one folder with an
+// index.html that shows the tables and pictures (no server needed).
+//   1. A simulated three-finger hand (two DSA-like 14x6 pads per finger) grasps, palpates and
+//      slides over four objects; raw, averaging and Kalman fusion; accuracy/compaction table,
+//      PLY clouds, cloud pictures and an error-against-contacts plot.
+//   2. Recognition by ICP: Kalman clouds of grasped objects at random poses, recognised among a
+//      library of six models; confusion matrix.
+//   3. Pressure images (second paper): synthetic 32x32 palm grasps, segmentation and
+//      reconstruction pictures, conventional against hybrid features by 5-fold CV.
+//   4. A recorded DSACON32m session (data/sessions) replayed through the driver into fusion.
+//   taxel-demo [--quick] [OUTPUT-FOLDER]      (default taxel-demo-output)
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <functional>
+#include <random>
 #include <string>
 #include <string_view>
 #include <taxel/taxel.hpp>
+#include <vector>
+#if defined(TAXEL_DEMO_HAVE_PNG)
+#include <taxel/io/png.hpp>
+#endif
+#if defined(TAXEL_DEMO_HAVE_DRIVERS)
+#include <taxel/drivers/convert.hpp>
+#include <taxel/drivers/dsacon_device.hpp>
+#include <taxel/drivers/session.hpp>
+
+#include "../drivers/examples/device_cli.hpp"
+#endif
 
 namespace {
 
+using namespace taxel;
+namespace fs = std::filesystem;
 namespace tf = taxel::fusion;
+namespace ti = taxel::image;
+namespace tl = taxel::learn;
+namespace tr = taxel::registration;
 
-// Minimal ASCII PLY writer for the demo (a full reader/writer is planned in taxel::io).
-bool write_ply(const std::filesystem::path& path, const taxel::PointCloud<double>& cloud) {
-  std::ofstream out(path);
-  out << "ply\nformat ascii 1.0\nelement vertex " << cloud.size()
-      << "\nproperty double x\nproperty double y\nproperty double z\n";
-  for (const auto& f : cloud.fields) out << "property double " << f.name << "\n";
-  out << "end_header\n";
-  out.precision(9);
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    out << cloud.points[i].x() << ' ' << cloud.points[i].y() << ' ' << cloud.points[i].z();
-    for (const auto& f : cloud.fields) out << ' ' << f.values[i];
-    out << '\n';
-  }
-  return static_cast<bool>(out);
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
 }
+
+// The page: sections of tables, pictures and links, written at the end.
+struct Page {
+  std::string body;
+  std::vector<std::string> images;
+  void heading(const std::string& h) { body += "<h2>" + h + "</h2>\n"; }
+  void para(const std::string& p) { body += "<p>" + p + "</p>\n"; }
+  void table(const std::vector<std::string>& head,
+             const std::vector<std::vector<std::string>>& rows) {
+    body += "<table><tr>";
+    for (const auto& h : head) body.append("<th>").append(h).append("</th>");
+    body += "</tr>\n";
+    for (const auto& r : rows) {
+      body += "<tr>";
+      for (const auto& c : r) body.append("<td>").append(c).append("</td>");
+      body += "</tr>\n";
+    }
+    body += "</table>\n";
+  }
+  void figure(const std::string& file, const std::string& caption) {
+    images.push_back(file);
+    body.append("<figure><img src=\"").append(file).append("\" alt=\"").append(caption);
+    body.append("\"><figcaption>").append(caption).append("</figcaption></figure>\n");
+  }
+  void links(const std::vector<std::string>& files) {
+    body += "<p class=\"files\">";
+    for (const auto& f : files)
+      body.append("<a href=\"").append(f).append("\">").append(f).append("</a> ");
+    body += "</p>\n";
+  }
+  std::string html(const std::string& summary) const {
+    std::string h =
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n"
+        "<title>taxel demo</title>\n<style>\n"
+        "body{font-family:sans-serif;max-width:70em;margin:2em auto;padding:0 1em;color:#222}\n"
+        "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:.25em "
+        ".6em;"
+        "text-align:right}th{background:#eee}figure{display:inline-block;margin:.5em;"
+        "vertical-align:top}figcaption{font-size:.9em;color:#555;max-width:32em}"
+        "img{max-width:100%;border:1px solid #ddd}.files a{margin-right:.8em;font-size:.9em}\n"
+        "#image-check{color:#555;font-size:.9em}\n"
+        "</style></head><body>\n<h1>taxel: tactile perception, end to end</h1>\n<p>" +
+        summary + "</p>\n" + body +
+        "<p id=\"image-check\">checking pictures...</p>\n"
+        "<script>\n"
+        "window.addEventListener('load', () => {\n"
+        "  const imgs = Array.from(document.images);\n"
+        "  const broken = imgs.filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src);\n"
+        "  const p = document.getElementById('image-check');\n"
+        "  p.textContent = broken.length ? 'broken pictures: ' + broken.join(' ')\n"
+        "                                : 'all ' + imgs.length + ' pictures loaded';\n"
+        "  p.dataset.status = broken.length ? 'broken' : 'ok';\n"
+        "});\n</script>\n</body></html>\n";
+    return h;
+  }
+};
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+// Writes a picture as PNG (PPM without libpng; browsers do not show PPM) and returns its name.
+std::string write_picture(const fs::path& dir, const std::string& stem, const io::RgbImage& pic) {
+#if defined(TAXEL_DEMO_HAVE_PNG)
+  const std::string name = stem + ".png";
+  io::write_png((dir / name).string(), pic);
+#else
+  const std::string name = stem + ".ppm";
+  io::write_file((dir / name).string(), io::encode_ppm(pic));
+#endif
+  return name;
+}
+
+// ---- 1. fusion ---------------------------------------------------------------------------------
+
+struct FusionRow {
+  std::string object, policy;
+  sim::ReconstructionMetrics m;
+  double ns = 0.0;
+};
 
 template <class Policy, class Shape>
-bool fuse_row(const char* shape_name, const char* policy_name, const Shape& shape,
-              const std::vector<taxel::Contact<double>>& contacts,
-              const std::filesystem::path& dir) {
-  tf::ContactCloud<Policy> cloud({.association_radius = 3.4e-3});
-  cloud.insert(std::span(contacts));
-  const auto pc = cloud.to_point_cloud();
-  const auto err = taxel::sim::surface_error(shape, pc.points);
-  std::printf("| %-9s | %-8s | %8zu | %7.1fx | %6.3f | %6.3f | %6.2f |\n", shape_name, policy_name,
-              cloud.size(),
-              static_cast<double>(contacts.size()) / static_cast<double>(cloud.size()),
-              err.mean * 1e3, err.rms * 1e3, err.max * 1e3);
-  const auto file = dir / (std::string(shape_name) + "_" + policy_name + ".ply");
-  if (!write_ply(file, pc)) {
-    std::fprintf(stderr, "taxel-demo: cannot write %s\n", file.c_str());
-    return false;
-  }
-  return true;
+FusionRow fuse(const std::string& object, const char* policy, const Shape& truth,
+               const std::vector<Contact<double>>& contacts, const fs::path& dir,
+               PointCloud<double>* kept = nullptr) {
+  tf::ContactCloud<Policy, index::VoxelHash<double>> cloud({.association_radius = 4e-3});
+  const auto t0 = Clock::now();
+  (void)cloud.insert(std::span<const Contact<double>>(contacts));
+  FusionRow r{
+      object, policy, {}, 1e9 * since(t0) / double(std::max<std::size_t>(1, contacts.size()))};
+  PointCloud<double> pc = cloud.to_point_cloud();
+  r.m = sim::reconstruction_metrics(truth, pc.points, contacts.size(), {.coverage_samples = 4000});
+  io::write_ply((dir / (object + "_" + policy + ".ply")).string(), pc);
+  if (kept != nullptr) *kept = std::move(pc);
+  return r;
 }
 
+// The hand's contacts on one object: grasps, palpation and slides with per-tactel contacts.
 template <class Shape>
-bool shape_rows(const char* name, const Shape& shape, std::size_t n,
-                const std::filesystem::path& dir) {
-  const auto contacts = taxel::sim::sliding_exploration(shape, n, {.sigma_tilt = 0.2, .seed = 3});
-  return fuse_row<tf::Raw<double>>(name, "raw", shape, contacts, dir) &&
-         fuse_row<tf::Average<double>>(name, "average", shape, contacts, dir) &&
-         fuse_row<tf::Kalman<double>>(name, "kalman", shape, contacts, dir);
+std::vector<Contact<double>> explore(const Shape& shape, const Isometry3d& pose, bool quick,
+                                     std::uint64_t seed) {
+  sim::ExplorationConfig cfg;
+  cfg.object_pose = pose;
+  cfg.seed = seed;
+  std::vector<Contact<double>> all;
+  const auto add = [&](const auto& ex) {
+    const auto c = ex.contacts();
+    all.insert(all.end(), c.begin(), c.end());
+  };
+  add(sim::explore_grasps(shape, cfg, {.grasps = quick ? 4 : 10}));
+  add(sim::explore_palpation(shape, cfg, {.touches = quick ? 15 : 40}));
+  add(sim::explore_sliding(shape, cfg, {.slides = quick ? 2 : 4, .frames = quick ? 300u : 500u}));
+  return all;
+}
+
+struct Object {
+  std::string name;
+  std::function<std::vector<Contact<double>>(const Isometry3d&, bool, std::uint64_t)> explore;
+  std::function<PointCloud<double>(std::size_t)> model;
+  std::function<std::vector<FusionRow>(const std::vector<Contact<double>>&, const fs::path&,
+                                       PointCloud<double>&)>
+      fuse_all;
+  std::function<std::vector<double>(const std::vector<Vec3d>&)> distances;
+  std::function<std::vector<double>(const std::vector<Contact<double>>&, std::size_t)> curve;
+};
+
+template <class Shape>
+Object make_object(std::string name, Shape shape) {
+  Object o;
+  o.name = name;
+  o.explore = [shape](const Isometry3d& pose, bool quick, std::uint64_t seed) {
+    return explore(shape, pose, quick, seed);
+  };
+  o.model = [shape](std::size_t n) { return sim::sample_surface(shape, n, 1); };
+  o.fuse_all = [shape, name](const std::vector<Contact<double>>& c, const fs::path& dir,
+                             PointCloud<double>& kalman) {
+    return std::vector<FusionRow>{fuse<tf::Raw<double>>(name, "raw", shape, c, dir),
+                                  fuse<tf::Average<double>>(name, "average", shape, c, dir),
+                                  fuse<tf::Kalman<double>>(name, "kalman", shape, c, dir, &kalman)};
+  };
+  o.distances = [shape](const std::vector<Vec3d>& pts) {
+    std::vector<double> d;
+    for (const auto& p : pts) d.push_back(1e3 * std::abs(shape.signed_distance(p)));
+    return d;
+  };
+  // RMS error [mm] of raw, average and Kalman after the first k contacts, k doubling.
+  o.curve = [shape](const std::vector<Contact<double>>& c, std::size_t k) {
+    std::vector<double> out;
+    const std::vector<Contact<double>> head(c.begin(), c.begin() + long(std::min(k, c.size())));
+    const auto rms = [&](auto&& cloud) {
+      (void)cloud.insert(std::span<const Contact<double>>(head));
+      return 1e3 * sim::surface_error(shape, cloud.to_point_cloud().points).rms;
+    };
+    out.push_back(rms(tf::ContactCloud<tf::Raw<double>>({.association_radius = 4e-3})));
+    out.push_back(rms(tf::ContactCloud<tf::Average<double>>({.association_radius = 4e-3})));
+    out.push_back(rms(tf::ContactCloud<tf::Kalman<double>>({.association_radius = 4e-3})));
+    return out;
+  };
+  return o;
+}
+
+void fusion_section(const std::vector<Object>& objects, bool quick, const fs::path& out,
+                    Page& page) {
+  std::printf(
+      "\n1. Contact fusion: a three-finger hand (two 14x6 DSA-like pads per finger, 3.4 mm "
+      "tactels, 12-bit readings) grasps, palpates and slides over each object\n");
+  std::printf("%-16s %-8s %8s %7s %8s %8s %8s %7s %8s\n", "object", "policy", "contacts", "points",
+              "compact", "mean mm", "rms mm", "max mm", "cover");
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> files;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const Object& o = objects[i];
+    const auto contacts = o.explore(Isometry3d::Identity(), quick, 100 + i);
+    PointCloud<double> kalman;
+    for (const FusionRow& r : o.fuse_all(contacts, out, kalman)) {
+      std::printf("%-16s %-8s %8zu %7zu %7.1fx %8.3f %8.3f %8.2f %6.1f%%\n", r.object.c_str(),
+                  r.policy.c_str(), r.m.contacts, r.m.points, r.m.compaction, 1e3 * r.m.error.mean,
+                  1e3 * r.m.error.rms, 1e3 * r.m.error.max, 100.0 * r.m.coverage);
+      rows.push_back({r.object, r.policy, std::to_string(r.m.contacts), std::to_string(r.m.points),
+                      fmt("%.1fx", r.m.compaction), fmt("%.3f", 1e3 * r.m.error.mean),
+                      fmt("%.3f", 1e3 * r.m.error.rms), fmt("%.2f", 1e3 * r.m.error.max),
+                      fmt("%.1f %%", 100.0 * r.m.coverage)});
+      files.push_back(r.object + "_" + r.policy + ".ply");
+    }
+    io::CloudView view;
+    view.title = o.name + ": Kalman cloud, " + std::to_string(kalman.size()) + " points";
+    view.value_label = "error mm";
+    view.value_min = 0.0;
+    io::write_file((out / (o.name + "_kalman.svg")).string(),
+                   io::render_cloud_svg(kalman.points, o.distances(kalman.points), view));
+  }
+  page.heading("1. Contact fusion: raw, averaging and Kalman");
+  page.para(
+      "A simulated three-finger hand with two 14x6 tactile pads per finger (3.4 mm tactels, "
+      "12-bit readings, 0.3 mm depth noise, 0.2 mm / 0.02 rad pose noise) grasps, palpates and "
+      "slides over each object. Every active tactel gives a contact with its anisotropic "
+      "covariance, fused with a 4 mm association gate. Errors are distances of the fused "
+      "points to the true surface; coverage is the share of the surface within 5 mm of a "
+      "point (sim/sensor.hpp, sim/exploration.hpp, fusion/).");
+  page.table({"object", "policy", "contacts", "points", "compaction", "mean mm", "RMS mm", "max mm",
+              "coverage"},
+             rows);
+  for (const Object& o : objects) {
+    page.figure(o.name + "_kalman.svg", o.name +
+                                            ": the Kalman-fused cloud, coloured by its "
+                                            "distance to the true surface");
+  }
+  // Error against contacts, for the first object.
+  const auto contacts = objects[1].explore(Isometry3d::Identity(), quick, 101);
+  io::LinePlot plot;
+  plot.title = "RMS error against contacts (" + objects[1].name + ")";
+  plot.x_label = "contacts (thousands)";
+  plot.y_label = "RMS distance to the surface (mm)";
+  plot.y_min = 0.0;
+  plot.series = {{"raw", {}, {}}, {"average", {}, {}}, {"kalman", {}, {}}};
+  for (std::size_t k = 500; k < contacts.size() * 2; k *= 2) {
+    const auto e = objects[1].curve(contacts, k);
+    for (std::size_t s = 0; s < 3; ++s) {
+      plot.series[s].x.push_back(double(std::min(k, contacts.size())) / 1000.0);
+      plot.series[s].y.push_back(e[s]);
+    }
+  }
+  io::write_file((out / "error_vs_contacts.svg").string(), io::render_svg(plot));
+  page.figure("error_vs_contacts.svg", "RMS error of the three policies as contacts accumulate");
+  page.links(files);
+}
+
+// ---- 2. recognition ------------------------------------------------------------------------
+
+void recognition_section(const std::vector<Object>& objects, bool quick, Page& page) {
+  tr::ObjectLibrary<double> lib;
+  for (const auto& o : objects) lib.add(o.name, o.model(8000));
+  const int trials = quick ? 1 : 3;
+  const std::size_t n = objects.size();
+  std::vector<std::vector<int>> confusion(n, std::vector<int>(n + 1, 0));
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  double seconds = 0.0;
+  int right = 0;
+  for (int t = 0; t < trials; ++t) {
+    for (std::size_t o = 0; o < n; ++o) {
+      Isometry3d pose = Isometry3d::Identity();
+      pose.linear() =
+          Eigen::Quaterniond(Eigen::Vector4d(g(rng), g(rng), g(rng), g(rng)).normalized())
+              .toRotationMatrix();
+      pose.translation() = 0.05 * Vec3d(g(rng), g(rng), g(rng));
+      // A short exploration (the quick one) at that pose, fused by Kalman filters.
+      tf::ContactCloud<tf::Kalman<double>> cloud({.association_radius = 4e-3});
+      const auto contacts = objects[o].explore(pose, true, 1000 + 10 * std::uint64_t(t) + o);
+      (void)cloud.insert(std::span<const Contact<double>>(contacts));
+      const auto t0 = Clock::now();
+      const tr::ObjectRecognition r = lib.recognize(cloud.to_point_cloud());
+      seconds += since(t0);
+      std::size_t answer = n;
+      for (std::size_t k = 0; k < n && !r.unknown; ++k)
+        answer = objects[k].name == r.best ? k : answer;
+      ++confusion[o][answer];
+      right += answer == o ? 1 : 0;
+    }
+  }
+  const int total = trials * int(n);
+  std::printf("\n2. Recognition by ICP among %zu models, %d trial(s) per object at random poses\n",
+              n, trials);
+  std::vector<std::string> head{"true \\ answer"};
+  for (const auto& o : objects) head.push_back(o.name);
+  head.push_back("unknown");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t o = 0; o < n; ++o) {
+    std::printf("%-16s", objects[o].name.c_str());
+    std::vector<std::string> row{objects[o].name};
+    for (std::size_t k = 0; k <= n; ++k) {
+      std::printf(" %3d", confusion[o][k]);
+      row.push_back(std::to_string(confusion[o][k]));
+    }
+    std::printf("\n");
+    rows.push_back(row);
+  }
+  std::printf("top-1 %d / %d, %.1f ms per recognition\n", right, total, 1e3 * seconds / total);
+  page.heading("2. Recognising objects by touch (ICP)");
+  page.para(
+      "Each object is explored by the hand at a random pose, its contacts fused by Kalman "
+      "filters, and the cloud matched against a library of the " +
+      std::to_string(n) +
+      " models by multi-start point-to-plane ICP (registration/object_library.hpp). "
+      "Top-1: " +
+      std::to_string(right) + " / " + std::to_string(total) + ", " +
+      fmt("%.1f", 1e3 * seconds / total) + " ms per recognition.");
+  page.table(head, rows);
+}
+
+// ---- 3. pressure images ----------------------------------------------------------------------
+
+void image_section(bool quick, const fs::path& out, Page& page) {
+  // The full run is the size of the paper's data set (and of 06_recognition_study): 25 subjects
+  // x 4 classes x 20 grasps x 2 hands = 4000 images.
+  const sim::PalmGraspSynth synth({}, 1);
+  const auto data = synth.dataset(quick ? 6 : 25, quick ? 5 : 20);
+  ti::Recognizer<> rec(32, 32);
+  tl::Dataset conv, hyb;
+  conv.x.resize(Eigen::Index(data.size()), ti::kRegionalFeatures);
+  hyb.x.resize(Eigen::Index(data.size()), 32 * 32 + ti::kRegionalFeatures);
+  std::vector<io::RgbImage> rows;
+  std::vector<bool> shown(5, false);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const ti::Recognition& r = rec.recognize(data[i].image);
+    if (!r.ok()) throw std::runtime_error("image " + std::to_string(i) + ": " + r.message);
+    conv.x.row(Eigen::Index(i)) = r.regional.transpose();
+    hyb.x.row(Eigen::Index(i)) = r.hybrid.transpose();
+    for (auto* d : {&conv, &hyb}) {
+      d->y.push_back(int(data[i].label));
+      d->groups.push_back(data[i].subject);
+    }
+    const auto label = std::size_t(data[i].label);
+    if (!shown[label]) {  // one picture row per class: image | segmentation | HPRs | height map
+      shown[label] = true;
+      const ti::Segmentation& seg = rec.segmentation();
+      ti::Image<std::uint8_t> hpr = seg.high;
+      rows.push_back(
+          io::side_by_side({io::colorize(data[i].image, 0, 255), io::colorize_classes(seg.classes),
+                            io::colorize_classes(hpr * std::uint8_t{2}),
+                            io::colorize(rec.reconstruction(), 0,
+                                         std::max(1e-9, rec.reconstruction().maxCoeff()))}));
+    }
+  }
+  const std::string picture = write_picture(out, "pressure_images", io::stacked(rows));
+  tl::LinearSvmConfig c;
+  c.C = 0.01;
+  const auto cv = [&](const tl::Dataset& d) {
+    tl::CvOptions opt;
+    opt.seed = 1;
+    const tl::CvReport r = tl::cross_validate(
+        tl::Scaled<tl::StandardScaler, tl::LinearSvm>(tl::LinearSvm(c)), d.view(), opt);
+    return 100.0 * r.accuracy;
+  };
+  const double a_conv = cv(conv), a_hyb = cv(hyb);
+  std::printf(
+      "\n3. Pressure images: %zu synthetic 32x32 palm grasps, 4 classes; linear SVM, "
+      "5-fold CV\n   conventional (11 region descriptors) %.1f %%, hybrid (reconstruction "
+      "gradients + descriptors) %.1f %%\n",
+      data.size(), a_conv, a_hyb);
+  page.heading("3. Pressure images: segmentation, reconstruction, recognition");
+  page.para(
+      "Synthetic 32x32 palm-grasp images of planar, one-edged, two-edged and cylindrical "
+      "objects (sim/palm_grasp.hpp; the paper's data are not public). Each goes through "
+      "1-D k-means segmentation, high-pressure regions, region descriptors, the edged / "
+      "edgeless decision and the 3-D reconstruction (image/). " +
+      std::to_string(data.size()) + " images, linear SVM, stratified 5-fold cross-validation:");
+  page.table({"features", "accuracy"},
+             {{"conventional: 11 region descriptors", fmt("%.1f %%", a_conv)},
+              {"hybrid: reconstruction gradients + descriptors", fmt("%.1f %%", a_hyb)}});
+  page.figure(picture,
+              "one image per class (rows: planar, one-edged, two-edged, cylindrical): "
+              "pressure | background/low/high | high-pressure regions | reconstruction");
+}
+
+// ---- 4. a recorded session --------------------------------------------------------------------
+
+void session_section(const fs::path& out, Page& page) {
+#if defined(TAXEL_DEMO_HAVE_DRIVERS)
+  namespace td = taxel::drivers;
+  const std::string dir = TAXEL_SESSION_DIR;
+  const auto poses = taxel_drivers_cli::read_poses_csv(dir + "/cylinder_grasp_poses.csv");
+  td::DsaconDevice dev(td::ReplayTransport::from_file(dir + "/cylinder_grasp.session"),
+                       {.frame_timeout = td::Timeout(50)});
+  dev.open();
+  dev.start();
+  tf::ContactCloud<tf::Kalman<double>> cloud({.association_radius = 4e-3});
+  std::vector<Contact<double>> contacts;
+  std::size_t frames = 0, total = 0;
+  io::RgbImage busiest;
+  std::size_t busiest_contacts = 0;
+  while (auto f = dev.read_frame()) {
+    ++frames;
+    const auto it = poses.find(f->device_time_ms);
+    if (it == poses.end()) continue;
+    contacts.clear();
+    td::frame_contacts(*f, dev.matrices(), it->second, contacts);
+    (void)cloud.insert(std::span<const Contact<double>>(contacts));
+    total += contacts.size();
+    if (contacts.size() > busiest_contacts) {  // picture of the frame with the most contact
+      busiest_contacts = contacts.size();
+      std::vector<io::RgbImage> panels;
+      for (std::size_t m = 0; m < f->matrices.size(); ++m)
+        panels.push_back(io::colorize(td::frame_image(*f, m), 0, 4095, 10));
+      busiest = io::side_by_side(panels);
+    }
+  }
+  const auto stats = dev.stats();
+  dev.close();
+  io::write_ply((out / "session_cloud.ply").string(), cloud.to_point_cloud());
+  std::printf(
+      "\n4. Recorded DSACON32m session replayed through the driver: %zu frames (%llu "
+      "dropped), %zu contacts fused into %zu points\n",
+      frames, static_cast<unsigned long long>(stats.dropped_frames), total, cloud.size());
+  page.heading("4. A recorded DSACON32m session through the driver");
+  page.para(
+      "data/sessions/cylinder_grasp.session: a simulated grasp of a cylinder streamed by the "
+      "emulated DSACON32m controller and recorded byte for byte (taxel-record). Replayed "
+      "through DsaconDevice: " +
+      std::to_string(frames) + " frames, " + std::to_string(stats.dropped_frames) + " dropped, " +
+      std::to_string(total) + " contacts fused into " + std::to_string(cloud.size()) + " points.");
+  if (busiest_contacts > 0) {
+    page.figure(write_picture(out, "session_frame", busiest),
+                "the frame with the most contact: the six 14x6 matrices, readings 0-4095");
+  }
+  page.links({"session_cloud.ply"});
+#else
+  (void)out;
+  std::printf("\n4. (drivers not built: no session replay; build with libusb-1.0-0-dev)\n");
+  page.heading("4. A recorded DSACON32m session");
+  page.para("Not run: taxel was built without its drivers (they need libusb-1.0-0-dev).");
+#endif
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   bool quick = false;
-  std::filesystem::path dir = "taxel-demo-output";
+  fs::path out = "taxel-demo-output";
   for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    if (arg == "--quick") {
+    const std::string_view a = argv[i];
+    if (a == "--quick") {
       quick = true;
-    } else if (arg == "--help" || arg == "-h") {
+    } else if (a == "-h" || a == "--help") {
       std::puts(
-          "usage: taxel-demo [--quick] [output-folder]   (default taxel-demo-output)\n"
-          "Fuses simulated sliding explorations of a sphere, a cylinder and a box with the\n"
-          "raw, averaging and Kalman policies, prints accuracy and compaction, and writes\n"
-          "the fused clouds as PLY files.");
+          "usage: taxel-demo [--quick] [OUTPUT-FOLDER]\n"
+          "Runs taxel end to end on simulated data and writes tables, PLY clouds,\n"
+          "pictures and an index.html into OUTPUT-FOLDER (default taxel-demo-output).");
       return 0;
-    } else if (!arg.empty() && arg[0] == '-') {
-      std::fprintf(stderr, "taxel-demo: unknown option '%s' (try --help)\n", argv[i]);
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "taxel-demo: unknown option '%s' (see --help)\n", argv[i]);
       return 2;
     } else {
-      dir = arg;
+      out = argv[i];
     }
   }
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) {
-    std::fprintf(stderr, "taxel-demo: cannot create %s: %s\n", dir.c_str(), ec.message().c_str());
-    return 1;
-  }
-  const std::size_t n = quick ? 20000 : 200000;
-  std::printf("taxel %s demo: %zu contacts per object, 3.4 mm pad, 2 mm association radius\n\n",
-              TAXEL_VERSION_STRING, n);
-  std::puts("| object    | policy   |   points | compact | mean mm | rms mm | max mm |");
-  std::puts("|-----------|----------|----------|---------|---------|--------|--------|");
-  const bool ok = shape_rows("sphere", taxel::sim::Sphere(0.04), n, dir) &&
-                  shape_rows("cylinder", taxel::sim::Cylinder(0.03, 0.05), n, dir) &&
-                  shape_rows("box", taxel::sim::Box(), n, dir);
-  if (!ok) return 1;
-  std::printf("\nPLY clouds written to %s/\n", dir.c_str());
+  fs::create_directories(out);
+  const auto t0 = Clock::now();
+  std::printf("taxel-demo%s: output in %s\n", quick ? " (quick)" : "", out.c_str());
+  const std::vector<Object> objects{
+      make_object("sphere-40", sim::Sphere(0.04)),
+      make_object("cylinder-30x100", sim::Cylinder(0.03, 0.05)),
+      make_object("box-80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02))),
+      make_object("cone-30x60", sim::Cone(0.03, 0.06)),
+      make_object("cube-50", sim::Box(Vec3d(0.025, 0.025, 0.025))),
+      make_object("sphere-25", sim::Sphere(0.025)),
+  };
+  Page page;
+  const std::vector<Object> fused(objects.begin(), objects.begin() + 4);
+  fusion_section(fused, quick, out, page);
+  recognition_section(objects, quick, page);
+  image_section(quick, out, page);
+  session_section(out, page);
+  const double seconds = since(t0);
+  io::write_file(
+      (out / "index.html").string(),
+      page.html("Everything below was computed by <code>taxel-demo" +
+                std::string(quick ? " --quick" : "") + "</code> in " + fmt("%.0f", seconds) +
+                " s on simulated data; each section names the "
+                "headers it uses. Clouds are PLY files (open them in MeshLab or "
+                "CloudCompare); the pictures are SVG and PNG."));
+  std::printf("\ndone in %.0f s; open %s\n", seconds, (out / "index.html").c_str());
   return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "taxel-demo: %s\n", e.what());
+  return 1;
 }

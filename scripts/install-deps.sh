@@ -8,10 +8,10 @@ what=${1:-test}
 pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev)
 case "$what" in
   build) ;;
-  test) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev) ;;
+  test) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium) ;;
   bench) pkgs+=(libbenchmark-dev libpng-dev liblinear-dev) ;;
   fuzz) pkgs+=(catch2 clang libclang-rt-14-dev) ;;
-  all) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev clang libclang-rt-14-dev) ;;
+  all) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium clang libclang-rt-14-dev) ;;
   *) echo "install-deps.sh: unknown set '$what' (build|test|bench|fuzz|all)" >&2; exit 2 ;;
 esac
 

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Line plots as standalone SVG text: a few series of (x, y) points with markers, axes with
 // 1-2-5 ticks, labels and a legend. Enough for study results (accuracy against noise, error
-// against contacts) that open in any browser; not a plotting library.
+// against contacts) that open in any browser; not a plotting library. And pictures of point
+// clouds: an orthographic view, points coloured by a value, with a colour bar.
 #pragma once
 
 #include <algorithm>
@@ -13,6 +14,9 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "taxel/core/types.hpp"
+#include "taxel/io/picture.hpp"
 
 namespace taxel::io {
 
@@ -206,6 +210,106 @@ inline std::string render_svg(const LinePlot& plot) {
            svg_num(right - 146) + "\" y2=\"" + svg_num(ly - 4) + "\" stroke=\"" + colour +
            "\" stroke-width=\"2\"/>\n<text x=\"" + svg_num(right - 140) + "\" y=\"" + svg_num(ly) +
            "\">" + svg_escape(s.name) + "</text>\n";
+  }
+  svg += "</svg>\n";
+  return svg;
+}
+
+/// A view of a point cloud for render_cloud_svg.
+struct CloudView {
+  std::string title;
+  std::string value_label;      ///< what the colour shows, with its unit
+  double azimuth_deg = 35.0;    ///< rotation about the world z axis
+  double elevation_deg = 25.0;  ///< tilt of the view above the x-y plane
+  double point_radius = 2.2;    ///< [px]
+  int width = 420;
+  int height = 360;
+  double value_min = std::numeric_limits<double>::quiet_NaN();  ///< NaN: from the data
+  double value_max = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// An SVG picture of `points` seen orthographically from (azimuth, elevation), far points drawn
+/// first, each coloured by `values[i]` (ramp of picture.hpp) with a colour bar; `values` may be
+/// empty (one colour). Non-finite points are left out. Throws std::invalid_argument when the
+/// sizes differ or the picture is smaller than 160 x 120.
+inline std::string render_cloud_svg(const std::vector<Vec3d>& points,
+                                    const std::vector<double>& values, const CloudView& view) {
+  using detail::svg_escape;
+  using detail::svg_num;
+  if (!values.empty() && values.size() != points.size()) {
+    throw std::invalid_argument("render_cloud_svg: " + std::to_string(values.size()) +
+                                " values for " + std::to_string(points.size()) + " points");
+  }
+  if (view.width < 160 || view.height < 120) {
+    throw std::invalid_argument("render_cloud_svg: the picture must be at least 160 x 120");
+  }
+  const double az = view.azimuth_deg * 3.14159265358979323846 / 180.0;
+  const double el = view.elevation_deg * 3.14159265358979323846 / 180.0;
+  // Screen axes: right, up, and towards the viewer.
+  const Vec3d right(std::cos(az), std::sin(az), 0.0);
+  const Vec3d toward(-std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el));
+  const Vec3d up = toward.cross(right);
+  struct P {
+    double x, y, depth, value;
+  };
+  std::vector<P> ps;
+  double vlo = std::numeric_limits<double>::infinity(), vhi = -vlo;
+  double xlo = vlo, xhi = -vlo, ylo = vlo, yhi = -vlo;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) continue;
+    const double v = values.empty() ? 0.0 : values[i];
+    ps.push_back({points[i].dot(right), points[i].dot(up), points[i].dot(toward), v});
+    xlo = std::min(xlo, ps.back().x);
+    xhi = std::max(xhi, ps.back().x);
+    ylo = std::min(ylo, ps.back().y);
+    yhi = std::max(yhi, ps.back().y);
+    if (std::isfinite(v)) {
+      vlo = std::min(vlo, v);
+      vhi = std::max(vhi, v);
+    }
+  }
+  if (std::isfinite(view.value_min)) vlo = view.value_min;
+  if (std::isfinite(view.value_max)) vhi = view.value_max;
+  std::sort(ps.begin(), ps.end(), [](const P& a, const P& b) { return a.depth < b.depth; });
+  const double top = 30.0, bottom = 20.0, left = 15.0, bar = 70.0;
+  const double w = view.width - left - bar, h = view.height - top - bottom;
+  const double span = std::max({xhi - xlo, yhi - ylo, 1e-12});
+  const double scale = ps.empty() ? 1.0 : std::min(w, h) / span;
+  const double cx = left + 0.5 * w - scale * 0.5 * (xlo + xhi);
+  const double cy = top + 0.5 * h + scale * 0.5 * (ylo + yhi);
+  const auto colour = [&](double v) {
+    const auto rgb = ramp(vhi > vlo ? (v - vlo) / (vhi - vlo) : 0.5);
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+    return std::string(buf);
+  };
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" +
+                    std::to_string(view.width) + "\" height=\"" + std::to_string(view.height) +
+                    "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  svg += "<text x=\"" + svg_num(0.5 * view.width) + "\" y=\"18\" text-anchor=\"middle\">" +
+         svg_escape(view.title) + "</text>\n";
+  for (const P& p : ps) {
+    svg += "<circle cx=\"" + svg_num(cx + scale * p.x) + "\" cy=\"" + svg_num(cy - scale * p.y) +
+           "\" r=\"" + svg_num(view.point_radius) + "\" fill=\"" + colour(p.value) + "\"/>\n";
+  }
+  if (!values.empty() && std::isfinite(vlo)) {
+    const double bx = view.width - bar + 15.0;
+    for (int k = 0; k < 20; ++k) {
+      const double y = top + h * (1.0 - (k + 1) / 20.0);
+      svg += "<rect x=\"" + svg_num(bx) + "\" y=\"" + svg_num(y) + "\" width=\"12\" height=\"" +
+             svg_num(h / 20.0 + 0.5) + "\" fill=\"" + colour(vlo + (vhi - vlo) * (k + 0.5) / 20.0) +
+             "\"/>\n";
+    }
+    char lo[32], hi[32];
+    std::snprintf(lo, sizeof lo, "%.3g", vlo);
+    std::snprintf(hi, sizeof hi, "%.3g", vhi);
+    svg +=
+        "<text x=\"" + svg_num(bx + 16) + "\" y=\"" + svg_num(top + 10) + "\">" + hi + "</text>\n";
+    svg +=
+        "<text x=\"" + svg_num(bx + 16) + "\" y=\"" + svg_num(top + h) + "\">" + lo + "</text>\n";
+    svg += "<text x=\"" + svg_num(bx + 6) + "\" y=\"" + svg_num(top + h + 15) +
+           "\" text-anchor=\"middle\">" + svg_escape(view.value_label) + "</text>\n";
   }
   svg += "</svg>\n";
   return svg;

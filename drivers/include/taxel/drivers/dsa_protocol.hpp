@@ -82,17 +82,17 @@ inline std::vector<std::uint8_t> encode_packet(std::uint8_t id,
                                                std::span<const std::uint8_t> payload) {
   if (payload.size() > 0xFFFF)
     throw std::length_error("dsa::encode_packet: payload over 65535 bytes");
-  std::vector<std::uint8_t> out{0xAA,
-                                0xAA,
-                                0xAA,
-                                id,
-                                static_cast<std::uint8_t>(payload.size()),
-                                static_cast<std::uint8_t>(payload.size() >> 8)};
-  out.insert(out.end(), payload.begin(), payload.end());
-  if (!payload.empty()) {
-    const std::uint16_t crc = crc16(payload, crc16(std::span(out).subspan(3, 3)));
-    out.push_back(static_cast<std::uint8_t>(crc));
-    out.push_back(static_cast<std::uint8_t>(crc >> 8));
+  const std::size_t n = payload.size();
+  std::vector<std::uint8_t> out(6 + n + (n > 0 ? 2 : 0));
+  out[0] = out[1] = out[2] = 0xAA;
+  out[3] = id;
+  out[4] = static_cast<std::uint8_t>(n);
+  out[5] = static_cast<std::uint8_t>(n >> 8);
+  if (n > 0) {
+    std::memcpy(out.data() + 6, payload.data(), n);
+    const std::uint16_t crc = crc16(std::span<const std::uint8_t>(out.data() + 3, 3 + n));
+    out[6 + n] = static_cast<std::uint8_t>(crc);
+    out[7 + n] = static_cast<std::uint8_t>(crc >> 8);
   }
   return out;
 }
