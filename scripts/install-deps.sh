@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Installs the Debian 12 packages taxel needs when they are missing.
-# Usage: scripts/install-deps.sh [build|test|bench|fuzz|all]   (default: test)
+# Usage: scripts/install-deps.sh [build|test|bench|demo|fuzz|all]   (default: test)
 set -euo pipefail
 
 what=${1:-test}
@@ -10,9 +10,10 @@ case "$what" in
   build) ;;
   test) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium) ;;
   bench) pkgs+=(libbenchmark-dev libpng-dev liblinear-dev) ;;
+  demo) pkgs+=(libpng-dev libusb-1.0-0-dev) ;;
   fuzz) pkgs+=(catch2 clang libclang-rt-14-dev) ;;
   all) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium clang libclang-rt-14-dev) ;;
-  *) echo "install-deps.sh: unknown set '$what' (build|test|bench|fuzz|all)" >&2; exit 2 ;;
+  *) echo "install-deps.sh: unknown set '$what' (build|test|bench|demo|fuzz|all)" >&2; exit 2 ;;
 esac
 
 missing=()

@@ -22,6 +22,20 @@
 
 namespace taxel::fusion {
 
+namespace detail {
+/// An index's configuration type: `I::Config` when it has one, else an empty aggregate, so a
+/// user's index needs no Config to plug into ContactCloud.
+template <class I>
+struct index_config {
+  struct type {};
+};
+template <class I>
+requires requires { typename I::Config; }
+struct index_config<I> {
+  using type = typename I::Config;
+};
+}  // namespace detail
+
 /// What `ContactCloud::insert` did with a contact.
 enum class InsertStatus : std::uint8_t {
   added,     ///< started a new point
@@ -72,8 +86,8 @@ class ContactCloud {
     /// Euclidean association gate [m]: a contact fuses into the nearest point within this
     /// distance. Default: one tactel pitch of a Weiss DSA matrix (3.4 mm).
     Scalar association_radius = Scalar(3.4e-3);
-    typename F::Config fusion{};  ///< the policy's configuration
-    typename I::Config index{};   ///< the index's configuration
+    typename F::Config fusion{};                     ///< the policy's configuration
+    typename detail::index_config<I>::type index{};  ///< the index's configuration, if any
   };
 
   /// Throws std::invalid_argument when a field is out of range.
@@ -219,11 +233,15 @@ class ContactCloud {
     }
     return config;
   }
+  // The index, from (radius, config), (config) or nothing, whichever it takes.
   static I make_index(const Config& config) {
-    if constexpr (std::is_constructible_v<I, Scalar, const typename I::Config&>) {
+    using IC = typename detail::index_config<I>::type;
+    if constexpr (std::is_constructible_v<I, Scalar, const IC&>) {
       return I(config.association_radius, config.index);
-    } else {
+    } else if constexpr (std::is_constructible_v<I, const IC&>) {
       return I(config.index);
+    } else {
+      return I();
     }
   }
 
