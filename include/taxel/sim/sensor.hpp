@@ -30,10 +30,13 @@ struct Posed {
   Sh shape;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
 
+  /// Signed distance of a world point [m].
   double signed_distance(const Vec3d& p) const { return shape.signed_distance(pose.inverse() * p); }
+  /// Closest surface point, in the world.
   Vec3d closest_point(const Vec3d& p) const {
     return pose * shape.closest_point(pose.inverse() * p);
   }
+  /// Outward normal at the closest point, in the world.
   Vec3d normal(const Vec3d& p) const { return pose.linear() * shape.normal(pose.inverse() * p); }
 };
 

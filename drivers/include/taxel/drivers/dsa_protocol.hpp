@@ -162,7 +162,9 @@ class Parser {
     pos_ = 0;
     ready_.clear();
   }
+  /// What was seen so far.
   const ParserStats& stats() const noexcept { return stats_; }
+  /// The length bound [bytes].
   std::size_t max_payload() const noexcept { return max_payload_; }
 
  private:
@@ -311,6 +313,7 @@ struct MatrixInfo {
   std::size_t cells() const noexcept { return std::size_t(cells_x) * cells_y; }
 };
 
+/// Decodes a controller-info payload (18 or 19 bytes); throws ProtocolError otherwise.
 inline ControllerInfo decode_controller_info(std::span<const std::uint8_t> p) {
   detail::expect_size(p, 18, 19, "controller info");
   detail::Reader r(p, "controller info");
@@ -329,6 +332,7 @@ inline ControllerInfo decode_controller_info(std::span<const std::uint8_t> p) {
   return c;
 }
 
+/// The 18-byte controller-info payload a controller sends (for emulators and tests).
 inline std::vector<std::uint8_t> encode_controller_info(const ControllerInfo& c) {
   std::vector<std::uint8_t> o;
   detail::put(o, c.error_code);
@@ -344,6 +348,7 @@ inline std::vector<std::uint8_t> encode_controller_info(const ControllerInfo& c)
   return o;
 }
 
+/// Decodes a sensor-info payload (12 bytes); throws ProtocolError otherwise.
 inline SensorInfo decode_sensor_info(std::span<const std::uint8_t> p) {
   detail::expect_size(p, 12, 12, "sensor info");
   detail::Reader r(p, "sensor info");
@@ -357,6 +362,7 @@ inline SensorInfo decode_sensor_info(std::span<const std::uint8_t> p) {
   return s;
 }
 
+/// The 12-byte sensor-info payload.
 inline std::vector<std::uint8_t> encode_sensor_info(const SensorInfo& s) {
   std::vector<std::uint8_t> o;
   detail::put(o, s.error_code);
@@ -368,6 +374,8 @@ inline std::vector<std::uint8_t> encode_sensor_info(const SensorInfo& s) {
   return o;
 }
 
+/// Decodes a matrix-info payload (52 bytes, little-endian IEEE floats); throws ProtocolError
+/// otherwise.
 inline MatrixInfo decode_matrix_info(std::span<const std::uint8_t> p) {
   detail::expect_size(p, 52, 52, "matrix info");
   detail::Reader r(p, "matrix info");
@@ -387,6 +395,7 @@ inline MatrixInfo decode_matrix_info(std::span<const std::uint8_t> p) {
   return m;
 }
 
+/// The 52-byte matrix-info payload.
 inline std::vector<std::uint8_t> encode_matrix_info(const MatrixInfo& m) {
   std::vector<std::uint8_t> o;
   detail::put(o, m.error_code);

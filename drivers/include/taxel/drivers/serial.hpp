@@ -62,12 +62,15 @@ class SerialTransport {
     }
     ::tcflush(fd_, TCIOFLUSH);
   }
+  /// Closes the port (idempotent).
   void close() noexcept {
     if (fd_ >= 0) ::close(fd_);
     fd_ = -1;
   }
+  /// True between open() and close() or a lost device.
   bool is_open() const noexcept { return fd_ >= 0; }
 
+  /// Writes every byte within `timeout` or throws (timeout, disconnected).
   void write(std::span<const std::uint8_t> bytes, Timeout timeout) {
     require_open();
     const auto deadline = std::chrono::steady_clock::now() + timeout;
@@ -86,6 +89,7 @@ class SerialTransport {
     }
   }
 
+  /// Reads what arrives within `timeout` (0 bytes on timeout); a hang-up throws disconnected.
   std::size_t read(std::span<std::uint8_t> into, Timeout timeout) {
     require_open();
     if (into.empty()) return 0;
@@ -100,6 +104,7 @@ class SerialTransport {
     lost("read");
   }
 
+  /// The device path.
   const std::string& path() const noexcept { return path_; }
 
  private:

@@ -148,13 +148,18 @@ template <Transport T>
 class RecordingTransport {
  public:
   explicit RecordingTransport(T inner) : inner_(std::move(inner)) {}
+  /// Forwarded to the wrapped transport.
   void open() { inner_.open(); }
+  /// Forwarded to the wrapped transport.
   void close() { inner_.close(); }
+  /// Forwarded to the wrapped transport.
   bool is_open() const { return inner_.is_open(); }
+  /// Writes through and records the chunk.
   void write(std::span<const std::uint8_t> bytes, Timeout timeout) {
     inner_.write(bytes, timeout);
     chunks_.push_back({now(), true, {bytes.begin(), bytes.end()}});
   }
+  /// Reads through and records what arrived.
   std::size_t read(std::span<std::uint8_t> into, Timeout timeout) {
     const std::size_t n = inner_.read(into, timeout);
     if (n > 0) chunks_.push_back({now(), false, {into.begin(), into.begin() + long(n)}});
@@ -162,6 +167,7 @@ class RecordingTransport {
   }
   /// What was recorded so far.
   const std::vector<SessionChunk>& chunks() const noexcept { return chunks_; }
+  /// The wrapped transport.
   T& inner() noexcept { return inner_; }
 
  private:
@@ -192,14 +198,18 @@ class ReplayTransport {
     return ReplayTransport(read_session(path), realtime);
   }
 
+  /// Starts (or resumes) the replay.
   void open() {
     open_ = true;
     start_ = std::chrono::steady_clock::now();
   }
+  /// Pauses the replay (the position is kept).
   void close() { open_ = false; }
+  /// True between open() and close().
   bool is_open() const { return open_; }
   bool finished() const { return host_ >= chunks_.size() && dev_ >= chunks_.size(); }
 
+  /// Checks `bytes` against the recorded host stream.
   void write(std::span<const std::uint8_t> bytes, Timeout) {
     if (!open_) throw TransportError(TransportErrorKind::not_open, "replay: not open");
     for (const std::uint8_t b : bytes) {
@@ -219,6 +229,7 @@ class ReplayTransport {
       }
     }
   }
+  /// The next recorded device bytes, if their command was written.
   std::size_t read(std::span<std::uint8_t> into, Timeout timeout) {
     if (!open_) throw TransportError(TransportErrorKind::not_open, "replay: not open");
     // Nothing to give: the end of the device stream, or its next bytes wait for a command.

@@ -33,6 +33,7 @@ class TransportError : public std::runtime_error {
  public:
   TransportError(TransportErrorKind kind, const std::string& what)
       : std::runtime_error(what), kind_(kind) {}
+  /// Which failure.
   TransportErrorKind kind() const noexcept { return kind_; }
 
  private:
@@ -66,16 +67,19 @@ class LoopbackTransport {
     return {LoopbackTransport(shared, 0), LoopbackTransport(shared, 1)};
   }
 
+  /// Opens this end; reconnects a disconnected pair.
   void open() {
     std::lock_guard lock(s_->m);
     s_->connected = true;
     s_->open[side_] = true;
   }
+  /// Closes this end (a blocked read on it returns with `not_open`).
   void close() {
     std::lock_guard lock(s_->m);
     s_->open[side_] = false;
     s_->cv.notify_all();
   }
+  /// True when this end is open and the pair connected.
   bool is_open() const {
     std::lock_guard lock(s_->m);
     return s_->open[side_] && s_->connected;
@@ -89,6 +93,7 @@ class LoopbackTransport {
     s_->cv.notify_all();
   }
 
+  /// Queues `bytes` for the other end (never blocks).
   void write(std::span<const std::uint8_t> bytes, Timeout = Timeout(0)) {
     std::lock_guard lock(s_->m);
     check();
@@ -96,6 +101,7 @@ class LoopbackTransport {
     q.insert(q.end(), bytes.begin(), bytes.end());
     s_->cv.notify_all();
   }
+  /// Waits up to `timeout` for bytes from the other end; returns how many were stored.
   std::size_t read(std::span<std::uint8_t> into, Timeout timeout) {
     std::unique_lock lock(s_->m);
     check();

@@ -57,6 +57,8 @@ class UsbTransport {
     if (ctx_ != nullptr) libusb_exit(ctx_);
   }
 
+  /// Finds the device, opens it, picks the bulk endpoints and claims the interface (detaching
+  /// a kernel driver). Throws TransportError naming the device on failure.
   void open() {
     close();
     if (ctx_ == nullptr) check(libusb_init(&ctx_), "libusb_init");
@@ -100,6 +102,7 @@ class UsbTransport {
     }
   }
 
+  /// Releases the interface and closes the device (idempotent).
   void close() noexcept {
     if (handle_ != nullptr) {
       libusb_release_interface(handle_, iface_);
@@ -109,8 +112,10 @@ class UsbTransport {
     pending_.clear();
     pending_at_ = 0;
   }
+  /// True between open() and close() or a lost device.
   bool is_open() const noexcept { return handle_ != nullptr; }
 
+  /// Bulk OUT of every byte; throws on timeout or a lost device.
   void write(std::span<const std::uint8_t> bytes, Timeout timeout) {
     require_open();
     while (!bytes.empty()) {
@@ -126,6 +131,7 @@ class UsbTransport {
     }
   }
 
+  /// Bytes from bulk IN (whole packets are buffered); 0 on timeout.
   std::size_t read(std::span<std::uint8_t> into, Timeout timeout) {
     require_open();
     if (into.empty()) return 0;
