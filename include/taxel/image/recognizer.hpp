@@ -166,7 +166,9 @@ class Recognizer {
                           lab(r, c + 1) != id;
         if (!edge) continue;
         const auto [gx, gy] = sobel_at(source, r, c);
-        sum_mag[slot] += std::hypot(gx, gy);
+        // sqrt, not hypot: Sobel sums of image values cannot overflow, and hypot costs about
+        // 20 ns a call (equal to 1 ulp).
+        sum_mag[slot] += std::sqrt(gx * gx + gy * gy);
         sum_dir[slot] += std::atan2(-gy, gx) * (180.0 / std::numbers::pi);
         count[slot] += 1;
       }
