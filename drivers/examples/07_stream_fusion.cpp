@@ -61,7 +61,7 @@ int run(T transport, const Options& o, const std::map<std::uint32_t, cli::Poses>
   std::vector<taxel::Contact<double>> contacts;
   std::size_t total_contacts = 0, frames = 0, posed = 0;
   double fuse_seconds = 0.0;
-  const long limit = o.frames >= 0 ? o.frames : (o.replay.empty() && !o.serial.empty()) ? 300 : -1;
+  const long limit = o.frames >= 0 ? o.frames : o.replay.empty() ? 300 : -1;  // live: 300
   const auto t0 = std::chrono::steady_clock::now();
   try {
     dev.open();
