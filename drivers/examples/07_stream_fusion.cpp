@@ -151,13 +151,11 @@ int main(int argc, char** argv) {
     if (!o.replay.empty())
       return run(td::ReplayTransport::from_file(o.replay, o.realtime), o, pose_table, args);
     if (!o.serial.empty()) return run(td::SerialTransport(o.serial), o, pose_table, args);
-    const std::size_t colon = o.usb.find(':');
-    if (colon == std::string::npos) args.fail("--usb takes VID:PID in hex");
-    const auto vid = std::stoul(o.usb.substr(0, colon), nullptr, 16);
-    const auto pid = std::stoul(o.usb.substr(colon + 1), nullptr, 16);
-    return run(
-        td::UsbTransport({.vendor_id = std::uint16_t(vid), .product_id = std::uint16_t(pid)}), o,
-        pose_table, args);
+    const auto ids = cli::parse_pair(o.usb, 16);
+    if (!ids) args.fail("--usb: '" + o.usb + "' is not of the form VID:PID (hex)");
+    return run(td::UsbTransport({.vendor_id = std::uint16_t(ids->first),
+                                 .product_id = std::uint16_t(ids->second)}),
+               o, pose_table, args);
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }

@@ -4,22 +4,43 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <taxel/drivers/dsa_protocol.hpp>
 #include <taxel/drivers/dsacon_emulator.hpp>
 #include <taxel/sim.hpp>
+#include <utility>
 #include <vector>
 
 namespace taxel_drivers_cli {
 
 namespace dsa = taxel::drivers::dsa;
 using Poses = std::vector<Eigen::Isometry3d>;
+
+/// "A:B" as two numbers in `base`, each at most 0xFFFF (a USB VID:PID in hex, a bus:address
+/// in decimal); nothing when the text has another form.
+inline std::optional<std::pair<unsigned, unsigned>> parse_pair(const std::string& text, int base) {
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  unsigned x = 0, y = 0;
+  const char* mid = text.data() + colon;
+  const char* end = text.data() + text.size();
+  const auto r1 = std::from_chars(text.data(), mid, x, base);
+  const auto r2 = std::from_chars(mid + 1, end, y, base);
+  if (r1.ec != std::errc() || r2.ec != std::errc() || r1.ptr != mid || r2.ptr != end ||
+      x > 0xFFFF || y > 0xFFFF) {
+    return std::nullopt;
+  }
+  return std::pair<unsigned, unsigned>(x, y);
+}
 
 /// Pad poses of each frame, keyed by the controller's time stamp [ms]. CSV with header
 /// `time_ms,matrix,x,y,z,qw,qx,qy,qz` (metres; unit quaternion pad -> world).

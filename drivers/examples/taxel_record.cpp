@@ -2,7 +2,6 @@
 // taxel-record: records a DSACON32m session (every byte both ways, time-stamped) from a serial
 // port, a USB device, or the emulated controller fed by a simulated grasp.
 #include <atomic>
-#include <charconv>
 #include <cstdio>
 #include <exception>
 #include <limits>
@@ -176,21 +175,10 @@ int main(int argc, char** argv) {
                       int(!o.emulate.empty());
   if (sources != 1) args.fail("give exactly one of --serial, --usb, --usb-bus, --emulate");
   if (!o.poses.empty() && o.emulate.empty()) args.fail("--poses needs --emulate");
-  // "A:B" as two numbers in `base`.
   const auto pair = [&](const std::string& text, int base, const char* what) {
-    const std::size_t colon = text.find(':');
-    unsigned x = 0, y = 0;
-    const char* end = text.data() + text.size();
-    const auto r1 =
-        std::from_chars(text.data(), text.data() + std::min(colon, text.size()), x, base);
-    const auto r2 = colon == std::string::npos
-                        ? std::from_chars_result{end, std::errc::invalid_argument}
-                        : std::from_chars(text.data() + colon + 1, end, y, base);
-    if (r1.ec != std::errc() || r2.ec != std::errc() || r1.ptr != text.data() + colon ||
-        r2.ptr != end || x > 0xFFFF || y > 0xFFFF) {
-      args.fail(std::string(what) + ": '" + text + "' is not of the form A:B");
-    }
-    return std::pair<unsigned, unsigned>(x, y);
+    const auto p = cli::parse_pair(text, base);
+    if (!p) args.fail(std::string(what) + ": '" + text + "' is not of the form A:B");
+    return *p;
   };
   if (o.frames < 0 && o.emulate.empty()) o.frames = 100;
   try {
