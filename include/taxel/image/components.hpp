@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "taxel/image/types.hpp"
@@ -23,68 +24,107 @@ class Components {
   /// Preallocates for `rows x cols` images.
   void reserve(Eigen::Index rows, Eigen::Index cols) {
     labels_.resize(rows, cols);
-    parent_.reserve(static_cast<std::size_t>(rows * cols) + 1);
-    remap_.reserve(static_cast<std::size_t>(rows * cols) + 1);
-    area_.reserve(static_cast<std::size_t>(rows * cols) + 1);
+    parent_.reserve(static_cast<std::size_t>(rows * cols) / 2 + 2);
+    remap_.reserve(static_cast<std::size_t>(rows * cols) / 2 + 2);
+    area_.reserve(static_cast<std::size_t>(rows * cols) / 2 + 2);
+    tally_.reserve(4 * (static_cast<std::size_t>(rows * cols) / 2 + 2));
   }
 
   /// Labels the non-zero pixels of `mask`; returns the number of components.
-  /// Two raster passes with union-find over provisional labels.
+  /// Two raster passes with union-find over provisional labels. The first pass decides from
+  /// the fewest neighbours possible (a set pixel above is adjacent to every other scanned
+  /// neighbour under 8-connectivity); every set's root is its smallest provisional label,
+  /// which is the label of the component's first pixel in raster order.
   int compute(const MaskView& mask, Connectivity connectivity = Connectivity::eight) {
     const Eigen::Index rows = mask.rows();
     const Eigen::Index cols = mask.cols();
     labels_.resize(rows, cols);
-    parent_.clear();
-    parent_.push_back(0);
+    parent_.resize(static_cast<std::size_t>(rows * cols) / 2 + 2);
+    std::int32_t* parent = parent_.data();
+    std::int32_t next = 1;
+    parent[0] = 0;
+    auto fresh = [&]() {
+      parent[next] = next;
+      return next++;
+    };
     const bool eight = connectivity == Connectivity::eight;
     for (Eigen::Index r = 0; r < rows; ++r) {
       const std::uint8_t* m = mask.data() + r * mask.outerStride();
       std::int32_t* lab = labels_.data() + r * cols;
-      const std::int32_t* up = r > 0 ? lab - cols : nullptr;
+      if (r == 0) {
+        for (Eigen::Index c = 0; c < cols; ++c) {
+          if (m[c] == 0) {
+            lab[c] = 0;
+          } else {
+            lab[c] = c > 0 && lab[c - 1] != 0 ? lab[c - 1] : fresh();
+          }
+        }
+        continue;
+      }
+      const std::int32_t* up = lab - cols;
       for (Eigen::Index c = 0; c < cols; ++c) {
         if (m[c] == 0) {
           lab[c] = 0;
           continue;
         }
-        std::int32_t best = 0;
-        auto see = [&](std::int32_t l) {
-          if (l == 0) return;
-          l = find(l);
-          if (best == 0) {
-            best = l;
-          } else if (l != best) {
-            const std::int32_t lo = std::min(l, best), hi = std::max(l, best);
-            parent_[static_cast<std::size_t>(hi)] = lo;
-            best = lo;
-          }
-        };
-        if (c > 0) see(lab[c - 1]);
-        if (up != nullptr) {
-          see(up[c]);
-          if (eight && c > 0) see(up[c - 1]);
-          if (eight && c + 1 < cols) see(up[c + 1]);
+        const std::int32_t left = c > 0 ? lab[c - 1] : 0;
+        if (up[c] != 0) {
+          lab[c] = up[c];
+          if (!eight && left != 0 && left != up[c]) unite(up[c], left);
+          continue;
         }
-        if (best == 0) {
-          best = static_cast<std::int32_t>(parent_.size());
-          parent_.push_back(best);
+        if (!eight) {
+          lab[c] = left != 0 ? left : fresh();
+          continue;
         }
-        lab[c] = best;
+        const std::int32_t ul = c > 0 ? up[c - 1] : 0;
+        const std::int32_t ur = c + 1 < cols ? up[c + 1] : 0;
+        const std::int32_t w = ul != 0 ? ul : left;  // ul and left touch: one set
+        if (w != 0) {
+          lab[c] = w;
+          if (ur != 0 && ur != w) unite(w, ur);
+        } else {
+          lab[c] = ur != 0 ? ur : fresh();
+        }
       }
     }
-    // Second pass: final ids in raster order of each component's first pixel, and areas.
-    remap_.assign(parent_.size(), 0);
-    area_.assign(1, 0);
+    // Flatten: a root keeps the next final id in raster order; a child takes its parent's,
+    // already final because parent < child.
+    remap_.resize(static_cast<std::size_t>(next));
+    std::int32_t* remap = remap_.data();
+    remap[0] = 0;
     count_ = 0;
-    for (Eigen::Index i = 0; i < labels_.size(); ++i) {
-      std::int32_t& l = labels_.data()[i];
-      if (l == 0) continue;
-      const auto root = static_cast<std::size_t>(find(l));
-      if (remap_[root] == 0) {
-        remap_[root] = ++count_;
-        area_.push_back(0);
-      }
-      l = remap_[root];
-      ++area_[static_cast<std::size_t>(l)];
+    for (std::int32_t l = 1; l < next; ++l) {
+      remap[l] = parent[l] == l ? ++count_ : remap[parent[l]];
+    }
+    // Areas in four interleaved tallies: a run of one label (above all the background) would
+    // otherwise chain every increment on the one before through memory.
+    const auto stride = static_cast<std::size_t>(count_) + 1;
+    tally_.assign(4 * stride, 0);
+    std::int32_t* t = tally_.data();
+    std::int32_t* lab = labels_.data();
+    const Eigen::Index total = rows * cols;
+    Eigen::Index i = 0;
+    for (; i + 4 <= total; i += 4) {
+      const std::int32_t l0 = remap[lab[i]], l1 = remap[lab[i + 1]];
+      const std::int32_t l2 = remap[lab[i + 2]], l3 = remap[lab[i + 3]];
+      lab[i] = l0;
+      lab[i + 1] = l1;
+      lab[i + 2] = l2;
+      lab[i + 3] = l3;
+      ++t[l0];
+      ++t[stride + static_cast<std::size_t>(l1)];
+      ++t[2 * stride + static_cast<std::size_t>(l2)];
+      ++t[3 * stride + static_cast<std::size_t>(l3)];
+    }
+    for (; i < total; ++i) {
+      lab[i] = remap[lab[i]];
+      ++t[lab[i]];
+    }
+    area_.resize(stride);
+    area_[0] = 0;
+    for (std::size_t l = 1; l < stride; ++l) {
+      area_[l] = t[l] + t[stride + l] + t[2 * stride + l] + t[3 * stride + l];
     }
     return count_;
   }
@@ -93,6 +133,8 @@ class Components {
   [[nodiscard]] int count() const noexcept { return count_; }
   /// Label image of the last `compute` (0 = background).
   [[nodiscard]] const Labels& labels() const noexcept { return labels_; }
+  /// Pixel counts indexed by component id (entry 0, the background, is 0).
+  [[nodiscard]] std::span<const std::int32_t> areas() const noexcept { return area_; }
   /// Pixel count of component `id` (1-based).
   [[nodiscard]] std::int32_t area(int id) const noexcept {
     return area_[static_cast<std::size_t>(id)];
@@ -100,17 +142,28 @@ class Components {
 
  private:
   std::int32_t find(std::int32_t l) noexcept {
-    while (parent_[static_cast<std::size_t>(l)] != l) {
-      const std::int32_t p = parent_[static_cast<std::size_t>(l)];
-      parent_[static_cast<std::size_t>(l)] = parent_[static_cast<std::size_t>(p)];
-      l = p;
+    std::int32_t* parent = parent_.data();
+    while (parent[l] != l) {
+      parent[l] = parent[parent[l]];
+      l = parent[l];
     }
     return l;
   }
 
+  // Joins the sets of a and b; the smaller root becomes the root.
+  void unite(std::int32_t a, std::int32_t b) noexcept {
+    a = find(a);
+    b = find(b);
+    if (a < b) {
+      parent_[static_cast<std::size_t>(b)] = a;
+    } else if (b < a) {
+      parent_[static_cast<std::size_t>(a)] = b;
+    }
+  }
+
   Labels labels_;
   std::vector<std::int32_t> parent_, remap_;
-  std::vector<std::int32_t> area_;
+  std::vector<std::int32_t> area_, tally_;
   int count_ = 0;
 };
 
@@ -122,10 +175,12 @@ inline int remove_small_regions(Mask& mask, int min_area, Components& workspace,
   int kept = 0;
   for (int id = 1; id <= n; ++id) kept += workspace.area(id) >= min_area ? 1 : 0;
   if (kept == n) return kept;
-  const Labels& lab = workspace.labels();
-  for (Eigen::Index i = 0; i < mask.size(); ++i) {
-    const std::int32_t id = lab.data()[i];
-    if (id != 0 && workspace.area(id) < min_area) mask.data()[i] = 0;
+  const std::int32_t* lab = workspace.labels().data();
+  const std::int32_t* area = workspace.areas().data();
+  std::uint8_t* m = mask.data();
+  const Eigen::Index total = mask.size();
+  for (Eigen::Index i = 0; i < total; ++i) {  // branch-free: region edges are unpredictable
+    m[i] &= static_cast<std::uint8_t>(0u - static_cast<unsigned>(area[lab[i]] >= min_area));
   }
   return kept;
 }

@@ -60,10 +60,10 @@ class RegionAnalyzer {
   explicit RegionAnalyzer(RegionPropsOptions opt = {}, Eigen::Index rows = 32,
                           Eigen::Index cols = 32)
       : opt_(opt), components_(rows, cols) {
-    const auto n = static_cast<std::size_t>(rows + cols);
-    points_.reserve(6 * static_cast<std::size_t>(rows) + 8);
-    hull_.reserve(6 * static_cast<std::size_t>(rows) + 8);
-    line_.reserve(64 * n + 64);
+    points_.reserve(4 * static_cast<std::size_t>(rows) + 8);
+    hull_.reserve(4 * static_cast<std::size_t>(rows) + 8);
+    row_first_.reserve(static_cast<std::size_t>(rows));
+    row_last_.reserve(static_cast<std::size_t>(rows));
     props_.convex_hull.reserve(6 * static_cast<std::size_t>(rows) + 8);
     parity_.resize(rows, cols);
     convex_image_.resize(rows, cols);
@@ -87,48 +87,79 @@ class RegionAnalyzer {
 
     const Eigen::Index rows = mask.rows();
     const Eigen::Index cols = mask.cols();
-    double n = 0, sx = 0, sy = 0;
+    // One pass: count, first and second moments as exact integers, bounding box, and the
+    // first and last pixel of every row (for the hull).
+    std::int64_t n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
     Eigen::Index rmin = rows, rmax = -1, cmin = cols, cmax = -1;
+    row_first_.assign(static_cast<std::size_t>(rows), -1);
+    row_last_.assign(static_cast<std::size_t>(rows), -1);
+    const Eigen::Index stride = mask.outerStride();
     for (Eigen::Index r = 0; r < rows; ++r) {
+      const std::uint8_t* m = mask.data() + r * stride;
+      std::int64_t rn = 0, rs = 0, rss = 0;
+      Eigen::Index first = -1, last = -1;
       for (Eigen::Index c = 0; c < cols; ++c) {
-        if (mask(r, c) == 0) continue;
-        n += 1;
-        sx += static_cast<double>(c);
-        sy += static_cast<double>(r);
-        rmin = std::min(rmin, r);
-        rmax = std::max(rmax, r);
-        cmin = std::min(cmin, c);
-        cmax = std::max(cmax, c);
+        if (m[c] == 0) continue;
+        if (first < 0) first = c;
+        last = c;
+        ++rn;
+        rs += c;
+        rss += c * c;
       }
+      if (rn == 0) continue;
+      row_first_[static_cast<std::size_t>(r)] = first;
+      row_last_[static_cast<std::size_t>(r)] = last;
+      n += rn;
+      sx += rs;
+      sxx += rss;
+      sy += rn * r;
+      syy += rn * r * r;
+      sxy += rs * r;
+      rmin = std::min(rmin, r);
+      rmax = r;
+      cmin = std::min(cmin, first);
+      cmax = std::max(cmax, last);
     }
     if (n == 0) return p;
     const double base = opt_.zero_based ? 0.0 : 1.0;
-    const double xbar = sx / n;  // 0-based
-    const double ybar = sy / n;
-    p.area = n;
+    const auto nd = static_cast<double>(n);
+    const double xbar = static_cast<double>(sx) / nd;  // 0-based
+    const double ybar = static_cast<double>(sy) / nd;
+    p.area = nd;
     p.centroid = {xbar + base, ybar + base};
     const auto w = static_cast<double>(cmax - cmin + 1);
     const auto h = static_cast<double>(rmax - rmin + 1);
     p.bounding_box = {static_cast<double>(cmin) + base - 0.5,
                       static_cast<double>(rmin) + base - 0.5, w, h};
-    p.extent = n / (w * h);
-    p.equiv_diameter = std::sqrt(4.0 * n / std::numbers::pi);
+    p.extent = nd / (w * h);
+    p.equiv_diameter = std::sqrt(4.0 * nd / std::numbers::pi);
 
-    // Second moments, y up, with the 1/12 of each pixel's own extent.
+    // Central second moments, y up, with the 1/12 of each pixel's own extent. For sides up to
+    // 1024 px, n^2 mu = n sxx - sx^2 is exact in 64-bit integers (below side^6 <= 2^60) and
+    // rounded once; larger images take a second, centred pass in floating point.
     double uxx = 0, uyy = 0, uxy = 0;
-    for (Eigen::Index r = rmin; r <= rmax; ++r) {
-      for (Eigen::Index c = cmin; c <= cmax; ++c) {
-        if (mask(r, c) == 0) continue;
-        const double x = static_cast<double>(c) - xbar;
-        const double y = -(static_cast<double>(r) - ybar);
-        uxx += x * x;
-        uyy += y * y;
-        uxy += x * y;
+    if (std::max(rows, cols) <= 1024) {
+      const double n2 = nd * nd;
+      uxx = static_cast<double>(n * sxx - sx * sx) / n2;
+      uyy = static_cast<double>(n * syy - sy * sy) / n2;
+      uxy = -static_cast<double>(n * sxy - sx * sy) / n2;
+    } else {
+      for (Eigen::Index r = rmin; r <= rmax; ++r) {
+        for (Eigen::Index c = cmin; c <= cmax; ++c) {
+          if (mask(r, c) == 0) continue;
+          const double x = static_cast<double>(c) - xbar;
+          const double y = -(static_cast<double>(r) - ybar);
+          uxx += x * x;
+          uyy += y * y;
+          uxy += x * y;
+        }
       }
+      uxx /= nd;
+      uyy /= nd;
+      uxy /= nd;
     }
-    uxx = uxx / n + 1.0 / 12.0;
-    uyy = uyy / n + 1.0 / 12.0;
-    uxy = uxy / n;
+    uxx += 1.0 / 12.0;
+    uyy += 1.0 / 12.0;
     const double common = std::sqrt((uxx - uyy) * (uxx - uyy) + 4 * uxy * uxy);
     p.major_axis = 2 * std::numbers::sqrt2 * std::sqrt(uxx + uyy + common);
     p.minor_axis = 2 * std::numbers::sqrt2 * std::sqrt(std::max(0.0, uxx + uyy - common));
@@ -151,7 +182,7 @@ class RegionAnalyzer {
     }
 
     euler(mask, rmin, rmax, cmin, cmax);
-    if (opt_.convex) convex(mask, rmin, rmax, cmin, cmax, base);
+    if (opt_.convex) convex(rmin, rmax, cmin, cmax, base);
     if (opt_.perimeter) perimeter(mask);
     return p;
   }
@@ -211,79 +242,98 @@ class RegionAnalyzer {
     return q;
   }
 
-  // Appends the integer points of the segment (x1, y1) -> (x2, y2), as poly2mask's line
-  // stepping does: along the longer axis, rounding the other coordinate half away from zero.
-  void int_line(std::int64_t x1, std::int64_t y1, std::int64_t x2, std::int64_t y2) {
+  // Toggles parity_ where the segment (x1, y1) -> (x2, y2) of the 5x sub-pixel polygon
+  // crosses a pixel-centre column. The segment's integer points are those poly2mask's line
+  // stepping gives (along the longer axis, the other coordinate rounded half away from zero);
+  // each pair of consecutive points that differ in x is a horizontal edge at (min x, min y).
+  // Only edges on pixel-centre columns (x = 5 col - 2) toggle the pixel below them.
+  void toggle_edges(std::int64_t x1, std::int64_t y1, std::int64_t x2, std::int64_t y2,
+                    Eigen::Index rows, Eigen::Index cols) {
     const std::int64_t dx = std::abs(x2 - x1);
     const std::int64_t dy = std::abs(y2 - y1);
-    const std::size_t start = line_.size();
-    bool flip = false;
-    if (dx == 0 && dy == 0) {
-      line_.push_back({x1, y1});
-      return;
-    }
+    if (dx == 0) return;  // no step in x: no horizontal edge
+    auto toggle = [&](std::int64_t xe, std::int64_t ye) {
+      if ((xe + 2) % 5 != 0) return;  // not on a pixel's centre column
+      const std::int64_t col = (xe + 2) / 5;
+      std::int64_t row = -floor_div(-(ye + 2), 5);  // ceil((ye + 2) / 5)
+      if (col < 1 || col > cols || row > rows) return;
+      row = std::max<std::int64_t>(1, row);
+      parity_(row - 1, col - 1) ^= 1;
+    };
     if (dx >= dy) {
       if (x1 > x2) {
         std::swap(x1, x2);
         std::swap(y1, y2);
-        flip = true;
       }
       const double m = static_cast<double>(y2 - y1) / static_cast<double>(x2 - x1);
-      for (std::int64_t x = x1; x <= x2; ++x) {
-        const double y = static_cast<double>(y1) + m * static_cast<double>(x - x1);
-        line_.push_back({x, round_away(y)});
-      }
+      auto y_at = [&](std::int64_t x) {
+        return round_away(static_cast<double>(y1) + m * static_cast<double>(x - x1));
+      };
+      // Every step moves one in x; only x = 3 (mod 5) can toggle.
+      std::int64_t x = x1 + ((3 - x1) % 5 + 5) % 5;
+      for (; x < x2; x += 5) toggle(x, std::min(y_at(x), y_at(x + 1)));
     } else {
       if (y1 > y2) {
         std::swap(x1, x2);
         std::swap(y1, y2);
-        flip = true;
       }
       const double m = static_cast<double>(x2 - x1) / static_cast<double>(y2 - y1);
-      for (std::int64_t y = y1; y <= y2; ++y) {
-        const double x = static_cast<double>(x1) + m * static_cast<double>(y - y1);
-        line_.push_back({round_away(x), y});
+      std::int64_t xp = x1;
+      for (std::int64_t y = y1 + 1; y <= y2; ++y) {
+        const std::int64_t x =
+            round_away(static_cast<double>(x1) + m * static_cast<double>(y - y1));
+        if (x != xp) toggle(std::min(x, xp), y - 1);
+        xp = x;
       }
     }
-    if (flip) std::reverse(line_.begin() + static_cast<std::ptrdiff_t>(start), line_.end());
   }
 
-  void convex(const MaskView& mask, Eigen::Index rmin, Eigen::Index rmax, Eigen::Index cmin,
-              Eigen::Index cmax, double base) {
+  void convex(Eigen::Index rmin, Eigen::Index rmax, Eigen::Index cmin, Eigen::Index cmax,
+              double base) {
     // Candidate points: edge midpoints of the first and last pixel of every row, in doubled
-    // bounding-box coordinates where pixel (1, 1) is the box's upper-left pixel.
+    // bounding-box coordinates where pixel (1, 1) is the box's upper-left pixel. Row r's
+    // midpoints lie on the levels y - 1, y, y + 1 (y = 2 (r - rmin + 1)), and only the least
+    // and the greatest x of a level can be hull vertices; the levels come out in ascending
+    // order, so the points are sorted by (y, x) without a sort.
     points_.clear();
+    std::int64_t pend_lo = 0, pend_hi = -1;  // the level y + 1 of the previous row
+    std::int64_t pend_y = -1;
+    auto level = [&](std::int64_t y, std::int64_t lo, std::int64_t hi) {
+      points_.push_back({lo, y});
+      if (hi != lo) points_.push_back({hi, y});
+    };
     for (Eigen::Index r = rmin; r <= rmax; ++r) {
-      Eigen::Index first = -1, last = -1;
-      for (Eigen::Index c = cmin; c <= cmax; ++c) {
-        if (mask(r, c) == 0) continue;
-        if (first < 0) first = c;
-        last = c;
-      }
+      const Eigen::Index first = row_first_[static_cast<std::size_t>(r)];
       if (first < 0) continue;
+      const Eigen::Index last = row_last_[static_cast<std::size_t>(r)];
       const std::int64_t y = 2 * (r - rmin + 1);
-      // The other midpoints of the row lie on segments between these six.
       const std::int64_t xf = 2 * (first - cmin + 1);
       const std::int64_t xl = 2 * (last - cmin + 1);
-      points_.push_back({xf - 1, y});
-      points_.push_back({xf, y - 1});
-      points_.push_back({xf, y + 1});
-      points_.push_back({xl, y - 1});
-      points_.push_back({xl, y + 1});
-      points_.push_back({xl + 1, y});
+      if (pend_y == y - 1) {
+        level(y - 1, std::min(pend_lo, xf), std::max(pend_hi, xl));
+      } else {
+        if (pend_y >= 0) level(pend_y, pend_lo, pend_hi);
+        level(y - 1, xf, xl);
+      }
+      level(y, xf - 1, xl + 1);
+      pend_y = y + 1;
+      pend_lo = xf;
+      pend_hi = xl;
     }
-    // Andrew's monotone chain; collinear points dropped.
-    std::sort(points_.begin(), points_.end(),
-              [](const P2& a, const P2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-    points_.erase(std::unique(points_.begin(), points_.end(),
-                              [](const P2& a, const P2& b) { return a.x == b.x && a.y == b.y; }),
-                  points_.end());
+    if (pend_y >= 0) level(pend_y, pend_lo, pend_hi);
+
+    // Andrew's monotone chain over the (y, x) order, collinear points dropped. In swapped
+    // coordinates that order is the usual one and the chains come out with the opposite turn,
+    // so they are reversed, then rotated to start at the least (x, y): the same vertices in
+    // the same order as the chain over a sort by (x, y).
     hull_.clear();
     if (points_.size() < 3) {
       hull_ = points_;
+      std::sort(hull_.begin(), hull_.end(),
+                [](const P2& a, const P2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
     } else {
       for (const P2& pt : points_) {
-        while (hull_.size() >= 2 && cross(hull_[hull_.size() - 2], hull_.back(), pt) <= 0) {
+        while (hull_.size() >= 2 && cross(hull_[hull_.size() - 2], hull_.back(), pt) >= 0) {
           hull_.pop_back();
         }
         hull_.push_back(pt);
@@ -291,12 +341,17 @@ class RegionAnalyzer {
       const std::size_t lower = hull_.size() + 1;
       for (std::size_t i = points_.size() - 1; i-- > 0;) {
         const P2& pt = points_[i];
-        while (hull_.size() >= lower && cross(hull_[hull_.size() - 2], hull_.back(), pt) <= 0) {
+        while (hull_.size() >= lower && cross(hull_[hull_.size() - 2], hull_.back(), pt) >= 0) {
           hull_.pop_back();
         }
         hull_.push_back(pt);
       }
       hull_.pop_back();
+      std::reverse(hull_.begin(), hull_.end());
+      const auto least = std::min_element(hull_.begin(), hull_.end(), [](const P2& a, const P2& b) {
+        return a.x < b.x || (a.x == b.x && a.y < b.y);
+      });
+      std::rotate(hull_.begin(), least, hull_.end());
     }
     const double ox = static_cast<double>(cmin) - 1.0 + base;
     const double oy = static_cast<double>(rmin) - 1.0 + base;
@@ -310,39 +365,27 @@ class RegionAnalyzer {
     // columns, and fill each column by the parity of the edges above each pixel centre.
     const Eigen::Index rows = rmax - rmin + 1;
     const Eigen::Index cols = cmax - cmin + 1;
-    line_.clear();
+    parity_.resize(rows, cols);
+    parity_.setZero();
     for (std::size_t i = 0; i < hull_.size(); ++i) {
       const P2& a = hull_[i];
       const P2& b = hull_[(i + 1) % hull_.size()];
-      int_line(round_half(5 * a.x - 3), round_half(5 * a.y - 3), round_half(5 * b.x - 3),
-               round_half(5 * b.y - 3));
-    }
-    parity_.resize(rows, cols);
-    parity_.setZero();
-    for (std::size_t i = 0; i + 1 < line_.size(); ++i) {
-      const std::int64_t d = line_[i + 1].x - line_[i].x;
-      if (d == 0) continue;
-      const std::int64_t xe = d > 0 ? line_[i].x : line_[i].x - 1;
-      const std::int64_t ye = std::min(line_[i].y, line_[i + 1].y);
-      if ((xe + 2) % 5 != 0) continue;  // not on a pixel's centre column
-      const std::int64_t col = (xe + 2) / 5;
-      std::int64_t row = -floor_div(-(ye + 2), 5);  // ceil((ye + 2) / 5)
-      if (col < 1 || col > cols || row > rows) continue;
-      row = std::max<std::int64_t>(1, row);
-      parity_(row - 1, col - 1) ^= 1;
+      toggle_edges(round_half(5 * a.x - 3), round_half(5 * a.y - 3), round_half(5 * b.x - 3),
+                   round_half(5 * b.y - 3), rows, cols);
     }
     convex_image_.resize(rows, cols);
-    double count = 0;
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      std::uint8_t inside = 0;
-      for (Eigen::Index r = 0; r < rows; ++r) {
-        inside ^= parity_(r, c);
-        convex_image_(r, c) = inside;
-        count += inside;
+    std::int64_t count = 0;
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      const std::uint8_t* above = r > 0 ? &convex_image_(r - 1, 0) : nullptr;
+      const std::uint8_t* par = &parity_(r, 0);
+      std::uint8_t* out = &convex_image_(r, 0);
+      for (Eigen::Index c = 0; c < cols; ++c) {
+        out[c] = static_cast<std::uint8_t>((above != nullptr ? above[c] : 0) ^ par[c]);
+        count += out[c];
       }
     }
-    props_.convex_area = count;
-    props_.solidity = count > 0 ? props_.area / count : 0.0;
+    props_.convex_area = static_cast<double>(count);
+    props_.solidity = count > 0 ? props_.area / props_.convex_area : 0.0;
   }
 
   void perimeter(const MaskView& mask) {
@@ -430,7 +473,8 @@ class RegionAnalyzer {
   RegionPropsOptions opt_;
   Components components_;
   RegionProps props_;
-  std::vector<P2> points_, hull_, line_;
+  std::vector<P2> points_, hull_;
+  std::vector<Eigen::Index> row_first_, row_last_;
   Image<std::uint8_t> parity_;
   Mask convex_image_;
   std::vector<RC> boundary_;

@@ -46,6 +46,9 @@ struct Segmentation : Outcome {
   int regions = 0;                ///< number of HPR components kept
   double background_level = 0.0;  ///< centroid of the background cluster (I0)
   double high_level = 0.0;        ///< centroid of the high-pressure cluster (I2)
+  double pixel_min = 0.0;         ///< smallest pixel value of the image
+  double pixel_max = 0.0;         ///< largest pixel value of the image
+  double pixel_mean = 0.0;        ///< mean pixel value of the image
 };
 
 /// Segmentation workspace; reusing it for images of one size allocates nothing.
@@ -73,6 +76,9 @@ class Segmenter {
     histogram_.reserve(std::min<std::size_t>(static_cast<std::size_t>(cfg.histogram_levels),
                                              static_cast<std::size_t>(rows * cols) * 4 + 256));
     level_class_.reserve(histogram_.capacity());
+    level_value_.reserve(histogram_.capacity());
+    levels_.reserve(static_cast<std::size_t>(rows * cols));
+    split_.reserve(4 * std::min(kSplitHistogramLevels, histogram_.capacity()));
   }
 
   /// The configuration.
@@ -102,72 +108,142 @@ class Segmenter {
 
     // Pressure values: negate for dark-is-pressure so that clusters ascend in pressure.
     const double sign = cfg_.polarity == Polarity::high_is_pressure ? 1.0 : -1.0;
+    // One branch-free pass: range, sum, and whether every pixel is a finite integer within
+    // +-2^31 (1.5 * 2^52 added and subtracted rounds to an integer; NaN fails every test).
+    // Four lanes of accumulators, so that no floating-point chain waits on its last add.
+    const Eigen::Index stride = img.outerStride();
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    double lo4[4] = {kInf, kInf, kInf, kInf};
+    double hi4[4] = {-kInf, -kInf, -kInf, -kInf};
+    double sum4[4] = {0, 0, 0, 0};
+    bool in_range = true;
     bool integral = cfg_.histogram_levels > 0;
-    double lo = std::numeric_limits<double>::infinity();
-    double hi = -lo;
     for (Eigen::Index r = 0; r < rows; ++r) {
-      for (Eigen::Index c = 0; c < cols; ++c) {
-        const double v = img(r, c);
-        if (!std::isfinite(v) || std::abs(v) > kMaxPixelMagnitude) {
-          return fail("pixel (" + std::to_string(r) + ", " + std::to_string(c) + ") is " +
-                      (std::isfinite(v) ? "beyond +-1e100" : "not finite"));
-        }
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-        // Integer-valued? (a truncating conversion, cheaper than std::floor without SSE4.1)
-        integral = integral && v > -2147483648.0 && v < 2147483647.0 &&
-                   static_cast<double>(static_cast<std::int32_t>(v)) == v;
+      const double* row = img.data() + r * stride;
+      bool row_ok = true;
+      bool row_int = true;
+      auto visit = [&](int lane, double v) {
+        row_ok &= std::abs(v) <= kMaxPixelMagnitude;
+        constexpr double kRound = 6755399441055744.0;  // 1.5 * 2^52
+        row_int &= std::abs(v) < 2147483648.0 && (v + kRound) - kRound == v;
+        lo4[lane] = v < lo4[lane] ? v : lo4[lane];
+        hi4[lane] = v > hi4[lane] ? v : hi4[lane];
+        sum4[lane] += v;
+      };
+      Eigen::Index c = 0;
+      for (; c + 4 <= cols; c += 4) {
+        visit(0, row[c]);
+        visit(1, row[c + 1]);
+        visit(2, row[c + 2]);
+        visit(3, row[c + 3]);
       }
+      for (; c < cols; ++c) visit(0, row[c]);
+      in_range = in_range && row_ok;
+      integral = integral && row_int;
     }
-    integral = integral && hi - lo < static_cast<double>(cfg_.histogram_levels);
-    if (integral) {
-      // Histogram over [lo, hi] in pressure order.
-      const std::size_t n = static_cast<std::size_t>(hi - lo) + 1;
-      histogram_.assign(n, 0);
+    const double lo = std::min(std::min(lo4[0], lo4[1]), std::min(lo4[2], lo4[3]));
+    const double hi = std::max(std::max(hi4[0], hi4[1]), std::max(hi4[2], hi4[3]));
+    const double sum = (sum4[0] + sum4[1]) + (sum4[2] + sum4[3]);
+    if (!in_range) {
       for (Eigen::Index r = 0; r < rows; ++r) {
         for (Eigen::Index c = 0; c < cols; ++c) {
-          const auto level = static_cast<std::size_t>(img(r, c) - lo);
-          ++histogram_[sign > 0 ? level : n - 1 - level];
+          const double v = img(r, c);
+          if (!std::isfinite(v) || std::abs(v) > kMaxPixelMagnitude) {
+            return fail("pixel (" + std::to_string(r) + ", " + std::to_string(c) + ") is " +
+                        (std::isfinite(v) ? "beyond +-1e100" : "not finite"));
+          }
         }
+      }
+    }
+    seg_.pixel_min = lo;
+    seg_.pixel_max = hi;
+    seg_.pixel_mean = sum / static_cast<double>(rows * cols);
+    integral = integral && hi - lo < static_cast<double>(cfg_.histogram_levels);
+    const int top = cfg_.k - 1;
+    std::uint8_t* classes = seg_.classes.data();
+    double* quantised = seg_.quantised.data();
+    std::uint8_t* high_raw = seg_.high_raw.data();
+    if (integral) {
+      // Histogram over [lo, hi] in pressure order; the levels are kept for the class pass.
+      const std::size_t n = static_cast<std::size_t>(hi - lo) + 1;
+      histogram_.assign(n, 0);
+      levels_.resize(static_cast<std::size_t>(rows * cols));
+      std::uint32_t* hist = histogram_.data();
+      std::int32_t* level = levels_.data();
+      const auto ilo = static_cast<std::int32_t>(lo);
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        const double* row = img.data() + r * stride;
+        for (Eigen::Index c = 0; c < cols; ++c) {
+          *level++ = static_cast<std::int32_t>(row[c]) - ilo;
+        }
+      }
+      level = levels_.data();
+      const Eigen::Index count = rows * cols;
+      if (n <= kSplitHistogramLevels) {
+        // Four interleaved histograms: runs of one value (the background) would otherwise
+        // chain every increment on the one before through memory.
+        split_.assign(4 * n, 0);
+        std::uint32_t* h = split_.data();
+        Eigen::Index i = 0;
+        for (; i + 4 <= count; i += 4) {
+          ++h[level[i]];
+          ++h[n + static_cast<std::size_t>(level[i + 1])];
+          ++h[2 * n + static_cast<std::size_t>(level[i + 2])];
+          ++h[3 * n + static_cast<std::size_t>(level[i + 3])];
+        }
+        for (; i < count; ++i) ++h[level[i]];
+        for (std::size_t j = 0; j < n; ++j) {
+          const std::uint32_t total = h[j] + h[n + j] + h[2 * n + j] + h[3 * n + j];
+          hist[sign > 0 ? j : n - 1 - j] = total;
+        }
+      } else if (sign > 0) {
+        for (Eigen::Index i = 0; i < count; ++i) ++hist[level[i]];
+      } else {
+        for (Eigen::Index i = 0; i < count; ++i) ++hist[n - 1 - level[i]];
       }
       kmeans_.fit_histogram(histogram_, sign > 0 ? lo : -hi);
     } else {
-      values_.clear();
+      values_.resize(static_cast<std::size_t>(rows * cols));
+      double* out = values_.data();
       for (Eigen::Index r = 0; r < rows; ++r) {
-        for (Eigen::Index c = 0; c < cols; ++c) values_.push_back(sign * img(r, c));
+        const double* row = img.data() + r * stride;
+        for (Eigen::Index c = 0; c < cols; ++c) *out++ = sign * row[c];
       }
       kmeans_.fit(values_);
     }
     seg_.kmeans = kmeans_.result();
     const KMeans1dResult& km = kmeans_.result();
     // Map cluster ranks to classes: lowest -> 0, highest -> k-1, middle ones in between.
-    const int top = cfg_.k - 1;
     auto class_of_cluster = [&](int cl) { return km.k == 1 ? 0 : (cl == km.k - 1 ? top : cl); };
     if (integral) {
       // One lookup per level instead of a search per pixel.
       const std::size_t n = histogram_.size();
       level_class_.resize(n);
+      level_value_.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
-        level_class_[i] =
-            static_cast<std::uint8_t>(km.cluster_of(sign * (lo + static_cast<double>(i))));
+        const int cl = km.cluster_of(sign * (lo + static_cast<double>(i)));
+        level_class_[i] = static_cast<std::uint8_t>(class_of_cluster(cl));
+        level_value_[i] = sign * km.centroids[static_cast<std::size_t>(cl)];
       }
-      for (Eigen::Index r = 0; r < rows; ++r) {
-        for (Eigen::Index c = 0; c < cols; ++c) {
-          const int cl = level_class_[static_cast<std::size_t>(img(r, c) - lo)];
-          const int cls = class_of_cluster(cl);
-          seg_.classes(r, c) = static_cast<std::uint8_t>(cls);
-          seg_.quantised(r, c) = sign * km.centroids[static_cast<std::size_t>(cl)];
-          seg_.high_raw(r, c) = static_cast<std::uint8_t>(cls == top ? 1 : 0);
-        }
+      const std::uint8_t* lc = level_class_.data();
+      const double* lv = level_value_.data();
+      const std::int32_t* level = levels_.data();
+      const auto utop = static_cast<std::uint8_t>(top);
+      for (Eigen::Index i = 0; i < rows * cols; ++i) {
+        const std::uint8_t cls = lc[level[i]];
+        classes[i] = cls;
+        quantised[i] = lv[level[i]];
+        high_raw[i] = cls == utop ? 1 : 0;
       }
     } else {
       for (Eigen::Index r = 0; r < rows; ++r) {
         for (Eigen::Index c = 0; c < cols; ++c) {
           const int cl = km.cluster_of(sign * img(r, c));
           const int cls = class_of_cluster(cl);
-          seg_.classes(r, c) = static_cast<std::uint8_t>(cls);
-          seg_.quantised(r, c) = sign * km.centroids[static_cast<std::size_t>(cl)];
-          seg_.high_raw(r, c) = static_cast<std::uint8_t>(cls == top ? 1 : 0);
+          const Eigen::Index i = r * cols + c;
+          classes[i] = static_cast<std::uint8_t>(cls);
+          quantised[i] = sign * km.centroids[static_cast<std::size_t>(cl)];
+          high_raw[i] = static_cast<std::uint8_t>(cls == top ? 1 : 0);
         }
       }
     }
@@ -192,6 +268,7 @@ class Segmenter {
     seg_.quantised.setZero();
     seg_.high.setZero();
     seg_.high_raw.setZero();
+    seg_.pixel_min = seg_.pixel_max = seg_.pixel_mean = 0.0;
     seg_.status = Status::invalid_input;
     seg_.message = std::move(why);
     seg_.kmeans = KMeans1dResult{};
@@ -205,6 +282,10 @@ class Segmenter {
   std::vector<double> values_;
   std::vector<std::uint32_t> histogram_;
   std::vector<std::uint8_t> level_class_;
+  std::vector<double> level_value_;
+  std::vector<std::int32_t> levels_;
+  std::vector<std::uint32_t> split_;
+  static constexpr std::size_t kSplitHistogramLevels = 4096;
 };
 
 /// Allocating convenience: segments one image.
