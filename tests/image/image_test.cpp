@@ -304,6 +304,46 @@ TEST_CASE("region descriptors agree with brute force on random masks", "[image]"
   }
 }
 
+TEST_CASE("region descriptors: the packed-row path equals the byte path", "[image]") {
+  // Masks up to 62 columns are analysed as 64-bit rows; wider ones byte by byte. The same
+  // region inside a mask widened with empty columns must give the same descriptors.
+  std::mt19937 rng(23);
+  ti::RegionAnalyzer narrow({}, 40, 62), wide({}, 40, 90);
+  for (int trial = 0; trial < 300; ++trial) {
+    const Eigen::Index rows = 1 + trial % 37, cols = 1 + (trial * 11) % 62;
+    const ti::Mask m = random_mask(rng, rows, cols, 0.05 + 0.9 * (trial % 7) / 6.0);
+    ti::Mask w = ti::Mask::Zero(rows, 90);
+    w.leftCols(cols) = m;
+    if (trial % 3 == 0) w.leftCols(cols) *= 7;  // any non-zero value is inside
+    const ti::RegionProps& a = narrow.compute(m);
+    const ti::RegionProps& b = wide.compute(w);
+    REQUIRE(a.area == b.area);
+    CHECK(a.centroid == b.centroid);
+    CHECK(a.bounding_box == b.bounding_box);
+    CHECK(a.major_axis == b.major_axis);
+    CHECK(a.minor_axis == b.minor_axis);
+    CHECK(a.orientation == b.orientation);
+    CHECK(a.euler_number == b.euler_number);
+    CHECK(a.euler_number4 == b.euler_number4);
+    CHECK(a.convex_area == b.convex_area);
+    CHECK(a.convex_hull == b.convex_hull);
+    CHECK(a.perimeter == Approx(b.perimeter).margin(1e-12));
+    CHECK((narrow.convex_image() == wide.convex_image()).all());
+  }
+  // Row packing of arbitrary byte values, against one bit per byte.
+  for (int trial = 0; trial < 200; ++trial) {
+    std::uniform_int_distribution<int> byte(0, 255), zero(0, 2);
+    std::vector<std::uint8_t> row(64);
+    for (auto& v : row) v = zero(rng) == 0 ? 0 : static_cast<std::uint8_t>(byte(rng));
+    const Eigen::Index cols = trial % 65;
+    std::uint64_t expect = 0;
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      expect |= std::uint64_t{row[static_cast<std::size_t>(c)] != 0} << c;
+    }
+    CHECK(ti::detail::pack_row(row.data(), cols) == expect);
+  }
+}
+
 TEST_CASE("Sobel gradients match MATLAB's imgradient test vector", "[image]") {
   ti::ImageD img(3, 3);
   img << 1, 2, 3, 4, 5, 6, 7, 8, 9;
@@ -460,6 +500,28 @@ TEST_CASE("segmentation: classes, polarity, small regions, degenerate images", "
   // Non-integer values take the sorting path and agree.
   const ti::Segmentation f = ti::segment(img * 0.5 + 0.25);
   CHECK((f.classes == s.classes).all());
+  CHECK(s.pixel_min == img.minCoeff());
+  CHECK(s.pixel_max == img.maxCoeff());
+  CHECK(s.pixel_mean == Approx(img.mean()).epsilon(1e-14));
+
+  // Integer images, negative ones too, take the histogram path; it agrees with sorting.
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::uniform_int_distribution<int> level(-300 + 7 * trial, 200 + 40 * trial);
+    ti::ImageD q(32, 32);
+    for (Eigen::Index i = 0; i < q.size(); ++i) q.data()[i] = level(rng);
+    for (const auto pol : {ti::Polarity::high_is_pressure, ti::Polarity::dark_is_pressure}) {
+      const ti::Segmentation h = ti::segment(q, {.polarity = pol, .min_area = 3});
+      const ti::Segmentation v =
+          ti::segment(q, {.polarity = pol, .min_area = 3, .histogram_levels = 0});
+      REQUIRE(h.ok());
+      CHECK(h.kmeans.centroids == v.kmeans.centroids);
+      CHECK((h.classes == v.classes).all());
+      CHECK((h.quantised == v.quantised).all());
+      CHECK((h.high == v.high).all());
+      CHECK(h.regions == v.regions);
+    }
+  }
 
   // A patch smaller than min_area disappears.
   ti::ImageD small = palm_image(false);

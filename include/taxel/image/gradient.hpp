@@ -67,31 +67,48 @@ inline std::pair<double, double> sobel_at(const ImageView& img, Eigen::Index r,
   return {(d + 2 * f + k) - (a + 2 * e + g), (g + 2 * h + k) - (a + 2 * b + d)};
 }
 
-/// Sobel gradient magnitude only, `sqrt(gx^2 + gy^2)` (no direction), into `magnitude`.
-/// The fast path of the hybrid features: interior pixels without border tests.
-inline void gradient_magnitude(const ImageView& img, ImageD& magnitude) {
+namespace detail {
+
+// Sobel magnitude of `img` into `out` (rows * cols values, row-major). The border pixels take
+// the replicate rule; the interior loop has no tests, so that it vectorises.
+inline void gradient_magnitude_into(const ImageView& img, double* out) noexcept {
   const Eigen::Index rows = img.rows();
   const Eigen::Index cols = img.cols();
-  magnitude.resize(rows, cols);
+  const Eigen::Index stride = img.outerStride();
+  auto border = [&](Eigen::Index r, Eigen::Index c) {
+    const auto [x, y] = sobel_at(img, r, c);
+    out[r * cols + c] = std::sqrt(x * x + y * y);
+  };
   for (Eigen::Index r = 0; r < rows; ++r) {
-    const bool inner_row = r > 0 && r + 1 < rows;
-    const Eigen::Index stride = img.outerStride();
-    const double* up = img.data() + (r > 0 ? r - 1 : 0) * stride;
+    if (r == 0 || r + 1 == rows || cols < 3) {
+      for (Eigen::Index c = 0; c < cols; ++c) border(r, c);
+      continue;
+    }
+    const double* up = img.data() + (r - 1) * stride;
     const double* mid = img.data() + r * stride;
-    const double* dn = img.data() + (r + 1 < rows ? r + 1 : rows - 1) * stride;
-    double* out = &magnitude(r, 0);
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      if (!inner_row || c == 0 || c + 1 == cols) {
-        const auto [x, y] = sobel_at(img, r, c);
-        out[c] = std::sqrt(x * x + y * y);
-        continue;
-      }
+    const double* dn = img.data() + (r + 1) * stride;
+    double* o = out + r * cols;
+    border(r, 0);
+    for (Eigen::Index c = 1; c + 1 < cols; ++c) {
       const double x =
           (up[c + 1] + 2 * mid[c + 1] + dn[c + 1]) - (up[c - 1] + 2 * mid[c - 1] + dn[c - 1]);
       const double y = (dn[c - 1] + 2 * dn[c] + dn[c + 1]) - (up[c - 1] + 2 * up[c] + up[c + 1]);
-      out[c] = std::sqrt(x * x + y * y);
+      o[c] = x * x + y * y;
     }
+    // Eigen's packet square root: std::sqrt keeps a scalar errno path under default flags.
+    Eigen::Map<Eigen::ArrayXd> inner(o + 1, cols - 2);
+    inner = inner.sqrt();
+    border(r, cols - 1);
   }
+}
+
+}  // namespace detail
+
+/// Sobel gradient magnitude only, `sqrt(gx^2 + gy^2)` (no direction), into `magnitude`.
+/// The fast path of the hybrid features: interior pixels without border tests.
+inline void gradient_magnitude(const ImageView& img, ImageD& magnitude) {
+  magnitude.resize(img.rows(), img.cols());
+  detail::gradient_magnitude_into(img, magnitude.data());
 }
 
 /// Allocating convenience: gradient magnitude and direction of `img`.

@@ -10,9 +10,11 @@
 #include <array>
 #include <cmath>
 #include <concepts>
+#include <cstdint>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "taxel/core/status.hpp"
 #include "taxel/image/components.hpp"
@@ -99,7 +101,7 @@ class Recognizer {
     result_.regional.setZero(kRegionalFeatures);
     result_.edge_features.setZero(kEdgeFeatures);
     result_.hybrid.setZero(rows * cols + kRegionalFeatures);
-    magnitude_.resize(rows, cols);
+    slot_.reserve(static_cast<std::size_t>(rows * cols) / 2 + 2);
     result_.message.reserve(64);
   }
 
@@ -107,33 +109,32 @@ class Recognizer {
   /// gives `invalid_input` with all features zero.
   const Recognition& recognize(const ImageView& img) {
     Recognition& res = result_;
-    res.regional.setZero();
-    res.edge_features.setZero();
-    res.hybrid.setZero();
     res.edged = false;
     res.contour_gradient = 0.0;
     res.label = -1;
     res.status = Status::ok;
     res.message.clear();
-    if (img.rows() != rows_ || img.cols() != cols_) {
-      res.status = Status::invalid_input;
-      res.message = "image size does not match the recognizer's";
+    auto fail = [&](Status status, const std::string& why) -> const Recognition& {
+      res.regional.setZero();
+      res.edge_features.setZero();
+      res.hybrid.setZero();
+      res.status = status;
+      res.message = why;
       return res;
+    };
+    if (img.rows() != rows_ || img.cols() != cols_) {
+      return fail(Status::invalid_input, "image size does not match the recognizer's");
     }
     const Segmentation& seg = segmenter_.run(img);
-    if (!seg.ok()) {
-      res.status = seg.status;
-      res.message = seg.message;
-      return res;
-    }
+    if (!seg.ok()) return fail(seg.status, seg.message);
 
     // Regional descriptors of the union of the HPRs.
     const RegionProps& props = analyzer_.compute(seg.high);
     regional_features(props, res.regional);
     res.edge_features.head<kRegionalFeatures>() = res.regional;
-    res.edge_features(11) = img.maxCoeff();
-    res.edge_features(12) = img.minCoeff();
-    res.edge_features(13) = img.mean();
+    res.edge_features(11) = seg.pixel_max;
+    res.edge_features(12) = seg.pixel_min;
+    res.edge_features(13) = seg.pixel_mean;
 
     // The three largest HPRs (components of the segmenter kept by the area rule) and the
     // Sobel gradients on their contour pixels.
@@ -152,32 +153,39 @@ class Recognizer {
       }
     }
     std::array<double, 3> sum_mag{0, 0, 0}, sum_dir{0, 0, 0}, count{0, 0, 0};
-    const Labels& lab = comps.labels();
     const ImageView source =
         cfg_.gradient_source == GradientSource::raw ? img : ImageView(seg.quantised);
-    for (Eigen::Index r = 0; r < rows_ && top[0] != 0; ++r) {
-      for (Eigen::Index c = 0; c < cols_; ++c) {
-        const int id = lab(r, c);
-        if (id == 0) continue;
-        const int slot = id == top[0] ? 0 : id == top[1] ? 1 : id == top[2] ? 2 : -1;
-        if (slot < 0) continue;
-        const bool edge = r == 0 || c == 0 || r + 1 == rows_ || c + 1 == cols_ ||
-                          lab(r - 1, c) != id || lab(r + 1, c) != id || lab(r, c - 1) != id ||
-                          lab(r, c + 1) != id;
-        if (!edge) continue;
-        const auto [gx, gy] = sobel_at(source, r, c);
-        // sqrt, not hypot: Sobel sums of image values cannot overflow, and hypot costs about
-        // 20 ns a call (equal to 1 ulp).
-        sum_mag[slot] += std::sqrt(gx * gx + gy * gy);
-        sum_dir[slot] += std::atan2(-gy, gx) * (180.0 / std::numbers::pi);
-        count[slot] += 1;
+    if (top[0] != 0) {
+      // Slot of every label: 0..2 for the three largest, 3 for the others and the background.
+      slot_.assign(static_cast<std::size_t>(n) + 1, 3);
+      for (int s = 0; s < 3; ++s) {
+        if (top[s] != 0) slot_[static_cast<std::size_t>(top[s])] = static_cast<std::uint8_t>(s);
+      }
+      const std::int32_t* lab = comps.labels().data();
+      for (Eigen::Index r = 0; r < rows_; ++r) {
+        const std::int32_t* row = lab + r * cols_;
+        const bool edge_row = r == 0 || r + 1 == rows_;
+        for (Eigen::Index c = 0; c < cols_; ++c) {
+          const std::int32_t id = row[c];
+          const int slot = slot_[static_cast<std::size_t>(id)];
+          if (slot == 3) continue;
+          const bool edge = edge_row || c == 0 || c + 1 == cols_ || row[c - cols_] != id ||
+                            row[c + cols_] != id || row[c - 1] != id || row[c + 1] != id;
+          if (!edge) continue;
+          const auto [gx, gy] = sobel_at(source, r, c);
+          // sqrt, not hypot: Sobel sums of image values cannot overflow, and hypot costs about
+          // 20 ns a call (equal to 1 ulp).
+          sum_mag[slot] += std::sqrt(gx * gx + gy * gy);
+          sum_dir[slot] += std::atan2(-gy, gx) * (180.0 / std::numbers::pi);
+          count[slot] += 1;
+        }
       }
     }
     for (int s = 0; s < 3; ++s) {
-      if (top[s] == 0) continue;
-      res.edge_features(14 + s) = comps.area(top[s]);
-      res.edge_features(17 + s) = sum_mag[s] / count[s];
-      res.edge_features(20 + s) = sum_dir[s] / count[s];
+      const bool present = top[s] != 0;
+      res.edge_features(14 + s) = present ? comps.area(top[s]) : 0.0;
+      res.edge_features(17 + s) = present ? sum_mag[s] / count[s] : 0.0;
+      res.edge_features(20 + s) = present ? sum_dir[s] / count[s] : 0.0;
     }
     res.contour_gradient = res.edge_features(17);
     res.edged = decider_.edged(res.edge_features);
@@ -185,8 +193,7 @@ class Recognizer {
     // Reconstruction and the hybrid vector.
     const ImageD& height =
         res.edged ? reconstructor_.rec_edged(seg) : reconstructor_.rec_edgeless(img, seg);
-    gradient_magnitude(height, magnitude_);
-    res.hybrid.head(rows_ * cols_) = magnitude_.reshaped<Eigen::RowMajor>();
+    detail::gradient_magnitude_into(height, res.hybrid.data());
     res.hybrid.tail<kRegionalFeatures>() = res.regional;
     res.label = classifier_.predict(res.hybrid);
     return res;
@@ -211,7 +218,7 @@ class Recognizer {
   Segmenter segmenter_;
   RegionAnalyzer analyzer_;
   Reconstructor reconstructor_;
-  ImageD magnitude_;
+  std::vector<std::uint8_t> slot_;
   Recognition result_;
 };
 

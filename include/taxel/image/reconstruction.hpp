@@ -109,17 +109,14 @@ class Reconstructor {
     double level = 0.0;
     bool raised = false;
     for (Eigen::Index r = 0; r < rows; ++r) {
-      Eigen::Index n0 = 0, n1 = 0, n2 = 0;
+      // Branch-free tallies: class edges within a row are unpredictable.
+      const std::uint8_t* row = &cls(r, 0);
+      Eigen::Index n0 = 0, n2 = 0;
       for (Eigen::Index c = 0; c < cols; ++c) {
-        const int v = cls(r, c);
-        if (v == 0) {
-          ++n0;
-        } else if (v >= top) {
-          ++n2;
-        } else {
-          ++n1;
-        }
+        n0 += row[c] == 0 ? 1 : 0;
+        n2 += row[c] >= top ? 1 : 0;
       }
+      const Eigen::Index n1 = cols - n0 - n2;
       if (static_cast<double>(n0) > edged_.background_fraction * static_cast<double>(cols)) {
         if (edged_.keep_level_on_skipped_rows) height_.row(r).setConstant(level);
         continue;
@@ -133,8 +130,11 @@ class Reconstructor {
         level -= step;
         raised = false;
       }
-      for (Eigen::Index c = 0; c < cols; ++c) {
-        if (edged_.fill_whole_row || cls(r, c) != 0) height_(r, c) = level;
+      double* out = &height_(r, 0);
+      if (edged_.fill_whole_row) {
+        for (Eigen::Index c = 0; c < cols; ++c) out[c] = level;
+      } else {
+        for (Eigen::Index c = 0; c < cols; ++c) out[c] = row[c] != 0 ? level : 0.0;
       }
     }
     if (edged_.postprocess != PostProcess::none) smooth3x3(edged_.postprocess);
@@ -164,7 +164,8 @@ class Reconstructor {
     keep_cols_.clear();
     for (Eigen::Index r = 0; r < rows; ++r) {
       Eigen::Index n0 = 0;
-      for (Eigen::Index c = 0; c < cols; ++c) n0 += cls(r, c) == 0 ? 1 : 0;
+      const std::uint8_t* row = &cls(r, 0);
+      for (Eigen::Index c = 0; c < cols; ++c) n0 += row[c] == 0 ? 1 : 0;
       if (static_cast<double>(n0) <= frac * static_cast<double>(cols)) keep_rows_.push_back(r);
     }
     if (keep_rows_.empty()) return height_;

@@ -7,8 +7,10 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <numbers>
 #include <vector>
 
@@ -47,6 +49,29 @@ struct RegionProps {
   double perimeter = 0;   ///< chain-code length of the outer boundaries, see below
 };
 
+namespace detail {
+
+/// The non-zero pixels of a mask row of at most 64 pixels as bits (bit c = pixel c).
+inline std::uint64_t pack_row(const std::uint8_t* m, Eigen::Index cols) noexcept {
+  std::uint64_t bits = 0;
+  Eigen::Index c = 0;
+  if constexpr (std::endian::native == std::endian::little) {
+    constexpr std::uint64_t kLow7 = 0x7F7F7F7F7F7F7F7FULL;
+    constexpr std::uint64_t kHigh = 0x8080808080808080ULL;
+    for (; c + 8 <= cols; c += 8) {
+      std::uint64_t x = 0;
+      std::memcpy(&x, m + c, 8);
+      // Bit 7 of every non-zero byte, then byte k's bit moved to bit k by one multiply.
+      const std::uint64_t nonzero = (((x & kLow7) + kLow7) | x) & kHigh;
+      bits |= (((nonzero >> 7) * 0x0102040810204080ULL) >> 56) << c;
+    }
+  }
+  for (; c < cols; ++c) bits |= std::uint64_t{m[c] != 0 ? 1u : 0u} << c;
+  return bits;
+}
+
+}  // namespace detail
+
 /// Region-descriptor workspace; reusing it for images of one size allocates nothing once the
 /// hull buffers have grown to their largest size.
 ///
@@ -64,6 +89,8 @@ class RegionAnalyzer {
     hull_.reserve(4 * static_cast<std::size_t>(rows) + 8);
     row_first_.reserve(static_cast<std::size_t>(rows));
     row_last_.reserve(static_cast<std::size_t>(rows));
+    quad_.reserve(2 * static_cast<std::size_t>(cols + 2));
+    packed_.reserve(static_cast<std::size_t>(rows));
     props_.convex_hull.reserve(6 * static_cast<std::size_t>(rows) + 8);
     parity_.resize(rows, cols);
     convex_image_.resize(rows, cols);
@@ -94,19 +121,45 @@ class RegionAnalyzer {
     row_first_.assign(static_cast<std::size_t>(rows), -1);
     row_last_.assign(static_cast<std::size_t>(rows), -1);
     const Eigen::Index stride = mask.outerStride();
+    // Masks up to kPackedCols wide are packed into one 64-bit word per row (with room for a
+    // zero border on both sides): moments come from the runs of each row, the Euler number
+    // from population counts of row pairs.
+    const bool packed = cols <= kPackedCols;
+    if (packed) packed_.resize(static_cast<std::size_t>(rows));
     for (Eigen::Index r = 0; r < rows; ++r) {
       const std::uint8_t* m = mask.data() + r * stride;
       std::int64_t rn = 0, rs = 0, rss = 0;
-      Eigen::Index first = -1, last = -1;
-      for (Eigen::Index c = 0; c < cols; ++c) {
-        if (m[c] == 0) continue;
-        if (first < 0) first = c;
-        last = c;
-        ++rn;
-        rs += c;
-        rss += c * c;
+      Eigen::Index first = 0, last = 0;
+      if (packed) {
+        std::uint64_t bits = detail::pack_row(m, cols);
+        packed_[static_cast<std::size_t>(r)] = bits;
+        if (bits == 0) continue;
+        first = std::countr_zero(bits);
+        last = 63 - std::countl_zero(bits);
+        // Sum of c and c^2 over a run a..b: closed forms.
+        auto squares = [](std::int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; };
+        while (bits != 0) {
+          const int a = std::countr_zero(bits);
+          const int len = std::countr_one(bits >> a);
+          const int b = a + len - 1;
+          rn += len;
+          rs += static_cast<std::int64_t>(a + b) * len / 2;
+          rss += squares(b) - squares(a - 1);
+          bits = b >= 63 ? 0 : bits & (~std::uint64_t{0} << (b + 1));
+        }
+      } else {
+        // Branch-free: a region's edges within a row are unpredictable.
+        for (Eigen::Index c = 0; c < cols; ++c) {
+          const std::int64_t b = m[c] != 0 ? 1 : 0;
+          rn += b;
+          rs += b * c;
+          rss += b * c * c;
+        }
+        if (rn == 0) continue;
+        while (m[first] == 0) ++first;
+        last = cols - 1;
+        while (m[last] == 0) --last;
       }
-      if (rn == 0) continue;
       row_first_[static_cast<std::size_t>(r)] = first;
       row_last_[static_cast<std::size_t>(r)] = last;
       n += rn;
@@ -195,26 +248,53 @@ class RegionAnalyzer {
   [[nodiscard]] const Mask& convex_image() const noexcept { return convex_image_; }
 
  private:
-  // Euler numbers from Gray's bit-quad counts over the zero-padded bounding box.
+  // Euler numbers from Gray's bit-quad counts over the zero-padded bounding box: each row pair
+  // is packed into one 0/1 byte row with a zero border, and the 2x2 windows are tallied
+  // without branches.
   void euler(const MaskView& mask, Eigen::Index rmin, Eigen::Index rmax, Eigen::Index cmin,
              Eigen::Index cmax) {
+    if (mask.cols() <= kPackedCols) {
+      // Bit j of a row word shifted left by one is the pixel of window column j - 1, so bit 0
+      // and bit cols + 1 are the zero border; window j spans bits j and j + 1.
+      const std::uint64_t valid = (std::uint64_t{1} << (mask.cols() + 1)) - 1;
+      std::uint64_t prev = 0;
+      int q1 = 0, q3 = 0, qd = 0;
+      for (Eigen::Index r = rmin; r <= rmax + 1; ++r) {
+        const std::uint64_t cur = r <= rmax ? packed_[static_cast<std::size_t>(r)] << 1 : 0;
+        const std::uint64_t a = prev, b = prev >> 1, d = cur, e = cur >> 1;
+        const std::uint64_t odd = (a ^ b ^ d ^ e) & valid;  // one or three set
+        const std::uint64_t pairs = (a & b) | (d & e);      // with an odd sum: three set
+        q1 += std::popcount(odd & ~pairs);
+        q3 += std::popcount(odd & pairs);
+        qd += std::popcount(((a & e & ~b & ~d) | (b & d & ~a & ~e)) & valid);
+        prev = cur;
+      }
+      props_.euler_number = (q1 - q3 - 2 * qd) / 4;
+      props_.euler_number4 = (q1 - q3 + 2 * qd) / 4;
+      return;
+    }
+    const Eigen::Index w = cmax - cmin + 1;
+    const auto padded = static_cast<std::size_t>(w + 2);
+    quad_.assign(2 * padded, 0);
+    std::uint8_t* above = quad_.data();
+    std::uint8_t* below = quad_.data() + padded;
     int q1 = 0, q3 = 0, qd = 0;
     const Eigen::Index stride = mask.outerStride();
-    for (Eigen::Index r = rmin - 1; r <= rmax; ++r) {
-      const std::uint8_t* top = r >= rmin ? mask.data() + r * stride : nullptr;
-      const std::uint8_t* bot = r + 1 <= rmax ? mask.data() + (r + 1) * stride : nullptr;
-      int a = 0, d = 0;  // left column of the 2x2 window
-      for (Eigen::Index c = cmin - 1; c <= cmax; ++c) {
-        const bool in = c + 1 <= cmax;
-        const int b = in && top != nullptr && top[c + 1] != 0 ? 1 : 0;
-        const int e = in && bot != nullptr && bot[c + 1] != 0 ? 1 : 0;
-        const int s = a + b + d + e;
-        q1 += s == 1 ? 1 : 0;
-        q3 += s == 3 ? 1 : 0;
-        qd += s == 2 && a == e ? 1 : 0;
-        a = b;
-        d = e;
+    for (Eigen::Index r = rmin; r <= rmax + 1; ++r) {
+      if (r <= rmax) {
+        const std::uint8_t* m = mask.data() + r * stride + cmin;
+        for (Eigen::Index c = 0; c < w; ++c) below[c + 1] = m[c] != 0 ? 1 : 0;
+      } else {
+        std::fill(below, below + padded, std::uint8_t{0});
       }
+      for (std::size_t c = 0; c + 1 < padded; ++c) {
+        const int a = above[c], b = above[c + 1], d = below[c], e = below[c + 1];
+        const int sum = a + b + d + e;
+        q1 += sum == 1 ? 1 : 0;
+        q3 += sum == 3 ? 1 : 0;
+        qd += (sum == 2) & (a == e) ? 1 : 0;
+      }
+      std::swap(above, below);
     }
     props_.euler_number = (q1 - q3 - 2 * qd) / 4;
     props_.euler_number4 = (q1 - q3 + 2 * qd) / 4;
@@ -475,6 +555,9 @@ class RegionAnalyzer {
   RegionProps props_;
   std::vector<P2> points_, hull_;
   std::vector<Eigen::Index> row_first_, row_last_;
+  std::vector<std::uint8_t> quad_;
+  std::vector<std::uint64_t> packed_;
+  static constexpr Eigen::Index kPackedCols = 62;
   Image<std::uint8_t> parity_;
   Mask convex_image_;
   std::vector<RC> boundary_;
