@@ -344,6 +344,44 @@ TEST_CASE("region descriptors: the packed-row path equals the byte path", "[imag
   }
 }
 
+TEST_CASE("fast_atan2 agrees with std::atan2", "[image]") {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> sobel(-1020, 1020), expo(-300, 300);
+  double worst = 0.0;
+  for (int i = 0; i < 400000; ++i) {
+    double y = 0, x = 0;
+    switch (i % 4) {
+      case 0:
+        y = u(rng), x = u(rng);
+        break;
+      case 1:
+        y = sobel(rng), x = sobel(rng);
+        break;  // the recognizer's inputs
+      case 2:
+        y = std::ldexp(u(rng), expo(rng)), x = std::ldexp(u(rng), expo(rng));
+        break;
+      default:
+        y = u(rng) * 1e-3, x = u(rng);
+        break;  // near the axes
+    }
+    const double a = ti::detail::fast_atan2(y, x), b = std::atan2(y, x);
+    worst = std::max(worst, std::abs(a - b));
+    if (std::abs(a - b) > 1e-15) FAIL_CHECK("atan2(" << y << ", " << x << ") " << a << " vs " << b);
+  }
+  CHECK(worst < 1e-15);
+  // Signed zeros, axes and the non-finite cases take std::atan2's values exactly.
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double y : {0.0, -0.0, 1.0, -1.0, inf, -inf}) {
+    for (const double x : {0.0, -0.0, 1.0, -1.0, inf, -inf}) {
+      const double a = ti::detail::fast_atan2(y, x), b = std::atan2(y, x);
+      CHECK(a == b);
+      CHECK(std::signbit(a) == std::signbit(b));
+    }
+  }
+  CHECK(std::isnan(ti::detail::fast_atan2(std::nan(""), 1.0)));
+}
+
 TEST_CASE("Sobel gradients match MATLAB's imgradient test vector", "[image]") {
   ti::ImageD img(3, 3);
   img << 1, 2, 3, 4, 5, 6, 7, 8, 9;

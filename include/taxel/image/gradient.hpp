@@ -7,12 +7,55 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 
 #include "taxel/image/types.hpp"
 
 namespace taxel::image {
+
+namespace detail {
+
+/// atan(num / den) for 0 <= num <= den, den > 0, within 1 ulp of std::atan: Cephes' rational
+/// approximation (S. L. Moshier, Cephes Math Library, atan.c: the coefficients below), with its
+/// reduction atan(t) = pi/4 + atan((t - 1) / (t + 1)) above t = 0.66, taken here straight from
+/// num and den so that one division forms the argument. Written without branches.
+inline double atan_ratio(double num, double den) noexcept {
+  constexpr double p0 = -8.750608600031904122785e-1, p1 = -1.615753718733365076637e1,
+                   p2 = -7.500855792314704667340e1, p3 = -1.228866684490136173410e2,
+                   p4 = -6.485021904942025371773e1;
+  constexpr double q0 = 2.485846490142306297962e1, q1 = 1.650270098316988542046e2,
+                   q2 = 4.328810604912902668951e2, q3 = 4.853903996359136964868e2,
+                   q4 = 1.945506571482613964425e2;
+  constexpr double kMoreBits = 6.123233995736765886130e-17;  // pi/2 - double(pi/2)
+  const bool high = num > 0.66 * den;
+  const double x = high ? (num - den) / (num + den) : num / den;
+  const double z = x * x;
+  const double p = (((p0 * z + p1) * z + p2) * z + p3) * z + p4;
+  const double q = ((((z + q0) * z + q1) * z + q2) * z + q3) * z + q4;
+  const double base = high ? std::numbers::pi / 4 : 0.0;
+  const double extra = high ? 0.5 * kMoreBits : 0.0;
+  return base + (x * (z * p / q) + x + extra);
+}
+
+/// atan2(y, x) within 4 ulp (absolute error below 1e-15) of std::atan2 for finite arguments,
+/// signed zeros included; several times faster than glibc's. Non-finite arguments and (0, 0)
+/// go to std::atan2.
+inline double fast_atan2(double y, double x) noexcept {
+  const double ax = std::abs(x);
+  const double ay = std::abs(y);
+  if (!(ax + ay > 0.0) || !(ax + ay < std::numeric_limits<double>::infinity())) {
+    return std::atan2(y, x);
+  }
+  const bool steep = ay > ax;
+  double r = atan_ratio(steep ? ax : ay, steep ? ay : ax);
+  r = steep ? std::numbers::pi / 2 - r : r;
+  r = std::signbit(x) ? std::numbers::pi - r : r;
+  return std::signbit(y) ? -r : r;
+}
+
+}  // namespace detail
 
 /// Sobel derivatives of `img` into `gx` and `gy` (resized to the image's size).
 /// `gx = I (x) [-1 0 1; -2 0 2; -1 0 1]`, `gy = I (x) [-1 -2 -1; 0 0 0; 1 2 1]`.
@@ -47,8 +90,10 @@ inline void gradient(const ImageView& img, ImageD& magnitude, ImageD& direction,
   for (Eigen::Index i = 0; i < gx.size(); ++i) {
     const double x = gx.data()[i];
     const double y = gy.data()[i];
-    magnitude.data()[i] = std::hypot(x, y);
-    direction.data()[i] = std::atan2(-y, x) * 180.0 / std::numbers::pi;
+    // sqrt unless the squares could overflow; hypot is several times slower.
+    const double big = std::max(std::abs(x), std::abs(y));
+    magnitude.data()[i] = big < 1e150 ? std::sqrt(x * x + y * y) : std::hypot(x, y);
+    direction.data()[i] = detail::fast_atan2(-y, x) * (180.0 / std::numbers::pi);
   }
 }
 

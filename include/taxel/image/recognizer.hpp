@@ -176,7 +176,7 @@ class Recognizer {
           // sqrt, not hypot: Sobel sums of image values cannot overflow, and hypot costs about
           // 20 ns a call (equal to 1 ulp).
           sum_mag[slot] += std::sqrt(gx * gx + gy * gy);
-          sum_dir[slot] += std::atan2(-gy, gx) * (180.0 / std::numbers::pi);
+          sum_dir[slot] += detail::fast_atan2(-gy, gx) * (180.0 / std::numbers::pi);
           count[slot] += 1;
         }
       }
