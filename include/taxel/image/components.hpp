@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -24,10 +25,11 @@ class Components {
   /// Preallocates for `rows x cols` images.
   void reserve(Eigen::Index rows, Eigen::Index cols) {
     labels_.resize(rows, cols);
-    parent_.reserve(static_cast<std::size_t>(rows * cols) / 2 + 2);
-    remap_.reserve(static_cast<std::size_t>(rows * cols) / 2 + 2);
-    area_.reserve(static_cast<std::size_t>(rows * cols) / 2 + 2);
-    tally_.reserve(4 * (static_cast<std::size_t>(rows * cols) / 2 + 2));
+    parent_.reserve(max_labels(rows, cols));
+    remap_.reserve(max_labels(rows, cols));
+    area_.reserve(max_labels(rows, cols));
+    tally_.reserve(4 * max_labels(rows, cols));
+    runs_.reserve(max_labels(rows, cols));
   }
 
   /// Labels the non-zero pixels of `mask`; returns the number of components.
@@ -38,8 +40,10 @@ class Components {
   int compute(const MaskView& mask, Connectivity connectivity = Connectivity::eight) {
     const Eigen::Index rows = mask.rows();
     const Eigen::Index cols = mask.cols();
+    runs_.clear();
+    if (cols <= 64) return compute_runs(mask, connectivity);
     labels_.resize(rows, cols);
-    parent_.resize(static_cast<std::size_t>(rows * cols) / 2 + 2);
+    parent_.resize(max_labels(rows, cols));
     std::int32_t* parent = parent_.data();
     std::int32_t next = 1;
     parent[0] = 0;
@@ -129,6 +133,31 @@ class Components {
     return count_;
   }
 
+  /// Clears from `mask`, which must be the mask of the last `compute`, every component with
+  /// fewer than `min_area` pixels. Returns the number of components kept.
+  int clear_small(Mask& mask, int min_area) const {
+    int kept = 0;
+    for (int id = 1; id <= count_; ++id) kept += area_[static_cast<std::size_t>(id)] >= min_area;
+    if (kept == count_) return kept;
+    std::uint8_t* m = mask.data();
+    if (!runs_.empty()) {
+      const auto cols = static_cast<std::ptrdiff_t>(mask.cols());
+      for (const Run& run : runs_) {
+        if (area_[static_cast<std::size_t>(run.label)] >= min_area) continue;
+        std::uint8_t* row = m + run.row * cols;
+        std::fill(row + run.begin, row + run.end + 1, std::uint8_t{0});
+      }
+      return kept;
+    }
+    const std::int32_t* lab = labels_.data();
+    const std::int32_t* area = area_.data();
+    const Eigen::Index total = mask.size();
+    for (Eigen::Index i = 0; i < total; ++i) {  // branch-free: region edges are unpredictable
+      m[i] &= static_cast<std::uint8_t>(0u - static_cast<unsigned>(area[lab[i]] >= min_area));
+    }
+    return kept;
+  }
+
   /// Number of components of the last `compute`.
   [[nodiscard]] int count() const noexcept { return count_; }
   /// Label image of the last `compute` (0 = background).
@@ -141,6 +170,76 @@ class Components {
   }
 
  private:
+  // Provisional labels (plus the background): a new label starts a run or a pixel with no
+  // labelled neighbour to its left, so a row holds at most (cols + 1) / 2 of them.
+  static std::size_t max_labels(Eigen::Index rows, Eigen::Index cols) noexcept {
+    return static_cast<std::size_t>(rows * ((cols + 1) / 2)) + 2;
+  }
+
+  // A horizontal run of set pixels: columns begin..end (inclusive) of a row.
+  struct Run {
+    std::int32_t row, begin, end, label;
+  };
+
+  // Masks up to 64 columns: rows as bit words, labels per run. A run joins the runs of the row
+  // above that overlap it (widened by one column each side under 8-connectivity); labels are
+  // written once, run by run, and areas are run lengths.
+  int compute_runs(const MaskView& mask, Connectivity connectivity) {
+    const Eigen::Index rows = mask.rows();
+    const Eigen::Index cols = mask.cols();
+    const int widen = connectivity == Connectivity::eight ? 1 : 0;
+    parent_.resize(max_labels(rows, cols));
+    std::int32_t* parent = parent_.data();
+    parent[0] = 0;
+    std::int32_t next = 1;
+    std::size_t prev_begin = 0, prev_end = 0;
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      std::uint64_t bits = detail::pack_row(mask.data() + r * mask.outerStride(), cols);
+      const std::size_t cur_begin = runs_.size();
+      std::size_t j = prev_begin;
+      while (bits != 0) {
+        const int a = std::countr_zero(bits);
+        const int len = std::countr_one(bits >> a);
+        const int b = a + len - 1;
+        bits = b >= 63 ? 0 : bits & (~std::uint64_t{0} << (b + 1));
+        while (j < prev_end && runs_[j].end < a - widen) ++j;
+        std::int32_t label = 0;
+        for (std::size_t k = j; k < prev_end && runs_[k].begin <= b + widen; ++k) {
+          if (label == 0) {
+            label = runs_[k].label;
+          } else {
+            unite(label, runs_[k].label);
+          }
+        }
+        if (label == 0) {
+          parent[next] = next;
+          label = next++;
+        }
+        runs_.push_back({static_cast<std::int32_t>(r), a, b, label});
+      }
+      prev_begin = cur_begin;
+      prev_end = runs_.size();
+    }
+    remap_.resize(static_cast<std::size_t>(next));
+    std::int32_t* remap = remap_.data();
+    remap[0] = 0;
+    count_ = 0;
+    for (std::int32_t l = 1; l < next; ++l) {
+      remap[l] = parent[l] == l ? ++count_ : remap[parent[l]];
+    }
+    area_.assign(static_cast<std::size_t>(count_) + 1, 0);
+    labels_.resize(rows, cols);
+    labels_.setZero();
+    std::int32_t* lab = labels_.data();
+    for (Run& run : runs_) {
+      run.label = remap[run.label];
+      std::int32_t* row = lab + static_cast<std::ptrdiff_t>(run.row) * cols;
+      std::fill(row + run.begin, row + run.end + 1, run.label);
+      area_[static_cast<std::size_t>(run.label)] += run.end - run.begin + 1;
+    }
+    return count_;
+  }
+
   std::int32_t find(std::int32_t l) noexcept {
     std::int32_t* parent = parent_.data();
     while (parent[l] != l) {
@@ -164,6 +263,7 @@ class Components {
   Labels labels_;
   std::vector<std::int32_t> parent_, remap_;
   std::vector<std::int32_t> area_, tally_;
+  std::vector<Run> runs_;
   int count_ = 0;
 };
 
@@ -171,18 +271,8 @@ class Components {
 /// `bwareaopen(BW, P)`, 8-connected by default). Returns the number of components kept.
 inline int remove_small_regions(Mask& mask, int min_area, Components& workspace,
                                 Connectivity connectivity = Connectivity::eight) {
-  const int n = workspace.compute(mask, connectivity);
-  int kept = 0;
-  for (int id = 1; id <= n; ++id) kept += workspace.area(id) >= min_area ? 1 : 0;
-  if (kept == n) return kept;
-  const std::int32_t* lab = workspace.labels().data();
-  const std::int32_t* area = workspace.areas().data();
-  std::uint8_t* m = mask.data();
-  const Eigen::Index total = mask.size();
-  for (Eigen::Index i = 0; i < total; ++i) {  // branch-free: region edges are unpredictable
-    m[i] &= static_cast<std::uint8_t>(0u - static_cast<unsigned>(area[lab[i]] >= min_area));
-  }
-  return kept;
+  workspace.compute(mask, connectivity);
+  return workspace.clear_small(mask, min_area);
 }
 
 /// Allocating convenience for `remove_small_regions`.

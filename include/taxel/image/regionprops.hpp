@@ -10,7 +10,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <numbers>
 #include <vector>
 
@@ -48,29 +47,6 @@ struct RegionProps {
   int euler_number4 = 0;  ///< objects - holes, objects 4-connected
   double perimeter = 0;   ///< chain-code length of the outer boundaries, see below
 };
-
-namespace detail {
-
-/// The non-zero pixels of a mask row of at most 64 pixels as bits (bit c = pixel c).
-inline std::uint64_t pack_row(const std::uint8_t* m, Eigen::Index cols) noexcept {
-  std::uint64_t bits = 0;
-  Eigen::Index c = 0;
-  if constexpr (std::endian::native == std::endian::little) {
-    constexpr std::uint64_t kLow7 = 0x7F7F7F7F7F7F7F7FULL;
-    constexpr std::uint64_t kHigh = 0x8080808080808080ULL;
-    for (; c + 8 <= cols; c += 8) {
-      std::uint64_t x = 0;
-      std::memcpy(&x, m + c, 8);
-      // Bit 7 of every non-zero byte, then byte k's bit moved to bit k by one multiply.
-      const std::uint64_t nonzero = (((x & kLow7) + kLow7) | x) & kHigh;
-      bits |= (((nonzero >> 7) * 0x0102040810204080ULL) >> 56) << c;
-    }
-  }
-  for (; c < cols; ++c) bits |= std::uint64_t{m[c] != 0 ? 1u : 0u} << c;
-  return bits;
-}
-
-}  // namespace detail
 
 /// Region-descriptor workspace; reusing it for images of one size allocates nothing once the
 /// hull buffers have grown to their largest size.

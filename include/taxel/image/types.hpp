@@ -3,7 +3,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <bit>
 #include <cstdint>
+#include <cstring>
 #include <string_view>
 
 namespace taxel::image {
@@ -41,5 +43,28 @@ enum class Polarity {
 constexpr std::string_view to_string(Polarity p) noexcept {
   return p == Polarity::high_is_pressure ? "high_is_pressure" : "dark_is_pressure";
 }
+
+namespace detail {
+
+/// The non-zero pixels of a mask row of at most 64 pixels as bits (bit c = pixel c).
+inline std::uint64_t pack_row(const std::uint8_t* m, Eigen::Index cols) noexcept {
+  std::uint64_t bits = 0;
+  Eigen::Index c = 0;
+  if constexpr (std::endian::native == std::endian::little) {
+    constexpr std::uint64_t kLow7 = 0x7F7F7F7F7F7F7F7FULL;
+    constexpr std::uint64_t kHigh = 0x8080808080808080ULL;
+    for (; c + 8 <= cols; c += 8) {
+      std::uint64_t x = 0;
+      std::memcpy(&x, m + c, 8);
+      // Bit 7 of every non-zero byte, then byte k's bit moved to bit k by one multiply.
+      const std::uint64_t nonzero = (((x & kLow7) + kLow7) | x) & kHigh;
+      bits |= (((nonzero >> 7) * 0x0102040810204080ULL) >> 56) << c;
+    }
+  }
+  for (; c < cols; ++c) bits |= std::uint64_t{m[c] != 0 ? 1u : 0u} << c;
+  return bits;
+}
+
+}  // namespace detail
 
 }  // namespace taxel::image
