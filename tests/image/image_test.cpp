@@ -384,6 +384,32 @@ TEST_CASE("fast_atan2 agrees with std::atan2", "[image]") {
   CHECK(std::isnan(ti::detail::fast_atan2(std::nan(""), 1.0)));
 }
 
+TEST_CASE("gradient_magnitude equals imgradient's magnitude, borders included", "[image]") {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-50.0, 300.0);
+  for (const auto& [rows, cols] : {std::pair<Eigen::Index, Eigen::Index>{1, 1},
+                                   {1, 7},
+                                   {7, 1},
+                                   {2, 2},
+                                   {2, 5},
+                                   {3, 3},
+                                   {5, 2},
+                                   {32, 32},
+                                   {14, 6},
+                                   {9, 40}}) {
+    ti::ImageD img(rows, cols);
+    for (Eigen::Index i = 0; i < img.size(); ++i) img.data()[i] = std::round(u(rng));
+    ti::ImageD fast, mag, dir;
+    ti::gradient_magnitude(img, fast);
+    ti::gradient(img, mag, dir);
+    REQUIRE(fast.rows() == rows);
+    REQUIRE(fast.cols() == cols);
+    for (Eigen::Index i = 0; i < img.size(); ++i) {
+      CHECK(fast.data()[i] == Approx(mag.data()[i]).epsilon(1e-14).margin(1e-12));
+    }
+  }
+}
+
 TEST_CASE("Sobel gradients match MATLAB's imgradient test vector", "[image]") {
   ti::ImageD img(3, 3);
   img << 1, 2, 3, 4, 5, 6, 7, 8, 9;

@@ -125,13 +125,14 @@ inline void gradient_magnitude_into(const ImageView& img, double* out) noexcept 
     out[r * cols + c] = std::sqrt(x * x + y * y);
   };
   for (Eigen::Index r = 0; r < rows; ++r) {
-    if (r == 0 || r + 1 == rows || cols < 3) {
+    if (cols < 3) {
       for (Eigen::Index c = 0; c < cols; ++c) border(r, c);
       continue;
     }
-    const double* up = img.data() + (r - 1) * stride;
+    // Replicate border: the first and last rows take themselves as their missing neighbour.
+    const double* up = img.data() + (r > 0 ? r - 1 : 0) * stride;
     const double* mid = img.data() + r * stride;
-    const double* dn = img.data() + (r + 1) * stride;
+    const double* dn = img.data() + (r + 1 < rows ? r + 1 : rows - 1) * stride;
     double* o = out + r * cols;
     border(r, 0);
     for (Eigen::Index c = 1; c + 1 < cols; ++c) {
