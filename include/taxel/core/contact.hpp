@@ -2,6 +2,7 @@
 // A tactile contact measurement and helpers for its measurement covariance.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -99,7 +100,9 @@ constexpr std::string_view to_string(ContactDefect d) noexcept {
 /// True when `m` equals its transpose to within 64 ulps of its largest entry.
 template <Scalar S>
 bool is_symmetric(const Mat3<S>& m) noexcept {
-  const S tol = S(64) * std::numeric_limits<S>::epsilon() * m.cwiseAbs().maxCoeff();
+  S largest = S(0);
+  for (Eigen::Index i = 0; i < 9; ++i) largest = std::max(largest, std::abs(m.data()[i]));
+  const S tol = S(64) * std::numeric_limits<S>::epsilon() * largest;
   return std::abs(m(0, 1) - m(1, 0)) <= tol && std::abs(m(0, 2) - m(2, 0)) <= tol &&
          std::abs(m(1, 2) - m(2, 1)) <= tol;
 }
@@ -116,11 +119,11 @@ bool is_symmetric_positive_definite(const Mat3<S>& m) noexcept {
 /// Checks a contact for the defects that would corrupt a model fed with it. O(1).
 template <Scalar S>
 ContactDefect check_contact(const Contact<S>& c) noexcept {
-  if (!c.position.allFinite()) return ContactDefect::non_finite_position;
-  if (!c.covariance.allFinite()) return ContactDefect::non_finite_covariance;
+  if (!all_finite(c.position)) return ContactDefect::non_finite_position;
+  if (!all_finite(c.covariance)) return ContactDefect::non_finite_covariance;
   if (!is_symmetric(c.covariance)) return ContactDefect::asymmetric_covariance;
   if (!is_symmetric_positive_definite(c.covariance)) return ContactDefect::indefinite_covariance;
-  if (c.normal && (!c.normal->allFinite() || std::abs(c.normal->norm() - S(1)) > S(1e-3))) {
+  if (c.normal && (!all_finite(*c.normal) || std::abs(c.normal->norm() - S(1)) > S(1e-3))) {
     return ContactDefect::bad_normal;
   }
   return ContactDefect::ok;

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 
 #include "taxel/core/concepts.hpp"
 
@@ -25,5 +26,17 @@ using Mat3f = Mat3<float>;
 using Mat3d = Mat3<double>;
 using Isometry3f = Isometry3<float>;
 using Isometry3d = Isometry3<double>;
+
+/// True when every coefficient of a fixed-size vector or matrix is finite. A plain loop that
+/// inlines (Eigen's allFinite is a non-inlined comparison of m - m in some builds); used on the
+/// per-contact paths.
+template <class Derived>
+[[nodiscard]] constexpr bool all_finite(const Eigen::MatrixBase<Derived>& m) noexcept {
+  bool ok = true;
+  for (Eigen::Index j = 0; j < m.cols(); ++j) {
+    for (Eigen::Index i = 0; i < m.rows(); ++i) ok &= std::isfinite(m.coeff(i, j));
+  }
+  return ok;
+}
 
 }  // namespace taxel

@@ -105,7 +105,7 @@ class ContactCloud {
         State fused = states_[id];
         if (policy_.fuse(fused, contact, meta_[id].observations)) {
           const Vec3<Scalar> mean = policy_.mean(fused);
-          if (!mean.allFinite() || !policy_.covariance(fused).allFinite()) {
+          if (!all_finite(mean) || !all_finite(policy_.covariance(fused))) {
             // Only reachable with extreme magnitudes (overflow); keep the model intact.
             return {InsertStatus::rejected, 0, ContactDefect::overflow};
           }

@@ -73,22 +73,41 @@ struct Kalman {
   }
 
   /// One Kalman update; false (state untouched) when the Mahalanobis gate refuses.
+  /// Written on the symmetric 3x3 entries: the innovation covariance is inverted by its
+  /// adjugate, and of the Joseph form only the upper triangle is formed, then mirrored.
   bool fuse(State& s, const Contact<S>& c, std::uint32_t) const {
-    Mat3<S> p_pred = s.covariance;
+    Mat3<S> pp = s.covariance;
     if (config_.process_noise > S(0)) {
-      p_pred.diagonal().array() += config_.process_noise * config_.process_noise;
+      pp.diagonal().array() += config_.process_noise * config_.process_noise;
     }
-    const Mat3<S> innovation_cov_inv = (p_pred + c.covariance).inverse();
+    const Mat3<S>& r = c.covariance;
+    // Innovation covariance (symmetric) and its inverse.
+    const S a = pp(0, 0) + r(0, 0), b = pp(0, 1) + r(0, 1), cc = pp(0, 2) + r(0, 2);
+    const S d = pp(1, 1) + r(1, 1), e = pp(1, 2) + r(1, 2), f = pp(2, 2) + r(2, 2);
+    const S i00 = d * f - e * e, i01 = cc * e - b * f, i02 = b * e - cc * d;
+    const S i11 = a * f - cc * cc, i12 = b * cc - a * e, i22 = a * d - b * b;
+    const S inv_det = S(1) / (a * i00 + b * i01 + cc * i02);
+    Mat3<S> si;
+    si << i00 * inv_det, i01 * inv_det, i02 * inv_det,  //
+        i01 * inv_det, i11 * inv_det, i12 * inv_det,    //
+        i02 * inv_det, i12 * inv_det, i22 * inv_det;
     const Vec3<S> innovation = c.position - s.mean;
-    if (config_.gate_chi2 && innovation.dot(innovation_cov_inv * innovation) > *config_.gate_chi2) {
-      return false;
-    }
-    const Mat3<S> gain = p_pred * innovation_cov_inv;
+    if (config_.gate_chi2 && innovation.dot(si * innovation) > *config_.gate_chi2) return false;
+    const Mat3<S> gain = pp * si;
     s.mean += gain * innovation;
-    const Mat3<S> i_minus_k = Mat3<S>::Identity() - gain;
-    const Mat3<S> joseph =
-        i_minus_k * p_pred * i_minus_k.transpose() + gain * c.covariance * gain.transpose();
-    s.covariance = S(0.5) * (joseph + joseph.transpose());
+    // Joseph form (I - K) P- (I - K)' + K R K', upper triangle: with B = (I - K) P- and
+    // C = K R, entry (i, j) is B(i, j) - B.row(i) . K.row(j) + C.row(i) . K.row(j).
+    const Mat3<S> bm = pp - gain * pp;
+    const Mat3<S> cm = gain * r;
+    const Mat3<S> diff = cm - bm;  // (C - B)
+    Mat3<S>& out = s.covariance;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = i; j < 3; ++j) {
+        const S v = bm(i, j) + diff.row(i).dot(gain.row(j));
+        out(i, j) = v;
+        out(j, i) = v;
+      }
+    }
     return true;
   }
   /// The filter mean [m].

@@ -68,7 +68,7 @@ class VoxelHash {
   /// Adds point `p` (finite) with a new `id`.
   void insert(PointId id, const Vec3<S>& p) {
     TAXEL_ASSERT(!contains(id), "VoxelHash::insert: id already stored");
-    TAXEL_ASSERT(p.allFinite(), "VoxelHash::insert: point is not finite");
+    TAXEL_ASSERT(all_finite(p), "VoxelHash::insert: point is not finite");
     if (id >= loc_.size()) loc_.resize(std::size_t{id} + 1, Loc{});
     place(id, p, key_of(p));
     ++size_;
@@ -77,7 +77,7 @@ class VoxelHash {
   /// Moves stored point `id` to `p` (finite).
   void move(PointId id, const Vec3<S>& p) {
     TAXEL_ASSERT(contains(id), "VoxelHash::move: id not stored");
-    TAXEL_ASSERT(p.allFinite(), "VoxelHash::move: point is not finite");
+    TAXEL_ASSERT(all_finite(p), "VoxelHash::move: point is not finite");
     const Loc at = loc_[id];
     Block& b = blocks_[at.block];
     const Key old_key = key_of(Vec3<S>(b.x[at.lane], b.y[at.lane], b.z[at.lane]));
@@ -138,9 +138,10 @@ class VoxelHash {
 
   /// The closest point within distance r of q (ties by id), if any. No allocation.
   [[nodiscard]] std::optional<Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
-    if (size_ == 0 || !q.allFinite() || !(r >= S(0))) return std::nullopt;
+    if (size_ == 0 || !all_finite(q) || !(r >= S(0))) return std::nullopt;
     const Vec3<S> t = q * inv_cell_;
-    if (r <= radius_ && t.cwiseAbs().maxCoeff() * S(8) * kEps < kMargin) {
+    const S extent = std::max(std::max(std::abs(t.x()), std::abs(t.y())), std::abs(t.z()));
+    if (r <= radius_ && extent < kMaxCell && extent * S(8) * kEps < kMargin) {
       return nearest_in_block(q, t, r);
     }
     const S rp = probe_radius(r);
@@ -176,7 +177,7 @@ class VoxelHash {
   /// Every point within distance r of q, ordered by `closer`.
   [[nodiscard]] std::vector<Neighbor<S>> within(const Vec3<S>& q, S r) const {
     std::vector<Neighbor<S>> out;
-    if (size_ == 0 || !q.allFinite() || !(r >= S(0))) return out;
+    if (size_ == 0 || !all_finite(q) || !(r >= S(0))) return out;
     const S r2 = r * r;
     auto visit = [&](const Block& b) {
       for (std::uint32_t l = 0; l < b.count; ++l) {
@@ -206,7 +207,7 @@ class VoxelHash {
   /// radius until k points are inside (a ball holding k points holds the k nearest).
   [[nodiscard]] std::vector<Neighbor<S>> knn(const Vec3<S>& q, std::size_t k) const {
     const std::size_t want = std::min(k, size_);
-    if (want == 0 || !q.allFinite()) return {};
+    if (want == 0 || !all_finite(q)) return {};
     for (S r = cell_ / 2;; r *= 2) {
       std::vector<Neighbor<S>> found = within(q, r);
       if (found.size() >= want || !std::isfinite(r)) {
@@ -390,7 +391,13 @@ class VoxelHash {
     Neighbor<S> best{0, r * r};
     bool found = false;
     auto visit = [&](const Block& b) { consider(b, q, best, found); };
-    const Key home = key_of(q);
+    // |t| < 2^30 here (the caller checks), so floor needs no clamp; t = q / cell as key_of
+    // computes it, hence the same cell.
+    auto floor_of = [](S v) {
+      const auto i = static_cast<std::int32_t>(v);
+      return i - static_cast<std::int32_t>(v < static_cast<S>(i));
+    };
+    const Key home{floor_of(t.x()), floor_of(t.y()), floor_of(t.z())};
     std::int32_t step[3];
     S gap2[3];
     for (int a = 0; a < 3; ++a) {
