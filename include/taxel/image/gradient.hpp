@@ -65,18 +65,21 @@ inline void sobel(const ImageView& img, ImageD& gx, ImageD& gy) {
   gx.resize(rows, cols);
   gy.resize(rows, cols);
   if (rows == 0 || cols == 0) return;
+  const Eigen::Index stride = img.outerStride();
   for (Eigen::Index r = 0; r < rows; ++r) {
-    const Eigen::Index ru = std::max<Eigen::Index>(r - 1, 0);
-    const Eigen::Index rd = std::min<Eigen::Index>(r + 1, rows - 1);
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      const Eigen::Index cl = std::max<Eigen::Index>(c - 1, 0);
-      const Eigen::Index cr = std::min<Eigen::Index>(c + 1, cols - 1);
-      const double a = img(ru, cl), b = img(ru, c), d = img(ru, cr);
-      const double e = img(r, cl), f = img(r, cr);
-      const double g = img(rd, cl), h = img(rd, c), k = img(rd, cr);
-      gx(r, c) = (d + 2 * f + k) - (a + 2 * e + g);
-      gy(r, c) = (g + 2 * h + k) - (a + 2 * b + d);
-    }
+    // Replicate border: clamped neighbour rows, and clamped columns at the two ends only.
+    const double* up = img.data() + (r > 0 ? r - 1 : 0) * stride;
+    const double* mid = img.data() + r * stride;
+    const double* dn = img.data() + (r + 1 < rows ? r + 1 : rows - 1) * stride;
+    double* ox = &gx(r, 0);
+    double* oy = &gy(r, 0);
+    auto at = [&](Eigen::Index c, Eigen::Index cl, Eigen::Index cr) {
+      ox[c] = (up[cr] + 2 * mid[cr] + dn[cr]) - (up[cl] + 2 * mid[cl] + dn[cl]);
+      oy[c] = (dn[cl] + 2 * dn[c] + dn[cr]) - (up[cl] + 2 * up[c] + up[cr]);
+    };
+    at(0, 0, cols > 1 ? 1 : 0);
+    for (Eigen::Index c = 1; c + 1 < cols; ++c) at(c, c - 1, c + 1);
+    if (cols > 1) at(cols - 1, cols - 2, cols - 1);
   }
 }
 
