@@ -92,15 +92,7 @@ class Components {
         }
       }
     }
-    // Flatten: a root keeps the next final id in raster order; a child takes its parent's,
-    // already final because parent < child.
-    remap_.resize(static_cast<std::size_t>(next));
-    std::int32_t* remap = remap_.data();
-    remap[0] = 0;
-    count_ = 0;
-    for (std::int32_t l = 1; l < next; ++l) {
-      remap[l] = parent[l] == l ? ++count_ : remap[parent[l]];
-    }
+    const std::int32_t* remap = flatten(next);
     // Areas in four interleaved tallies: a run of one label (above all the background) would
     // otherwise chain every increment on the one before through memory.
     const auto stride = static_cast<std::size_t>(count_) + 1;
@@ -220,13 +212,7 @@ class Components {
       prev_begin = cur_begin;
       prev_end = runs_.size();
     }
-    remap_.resize(static_cast<std::size_t>(next));
-    std::int32_t* remap = remap_.data();
-    remap[0] = 0;
-    count_ = 0;
-    for (std::int32_t l = 1; l < next; ++l) {
-      remap[l] = parent[l] == l ? ++count_ : remap[parent[l]];
-    }
+    const std::int32_t* remap = flatten(next);
     area_.assign(static_cast<std::size_t>(count_) + 1, 0);
     labels_.resize(rows, cols);
     labels_.setZero();
@@ -238,6 +224,20 @@ class Components {
       area_[static_cast<std::size_t>(run.label)] += run.end - run.begin + 1;
     }
     return count_;
+  }
+
+  // Final ids of provisional labels 1..next-1 (0 stays 0), counted into count_: a root takes
+  // the next id in raster order; a child its parent's, already final because parent < child.
+  const std::int32_t* flatten(std::int32_t next) {
+    remap_.resize(static_cast<std::size_t>(next));
+    std::int32_t* remap = remap_.data();
+    const std::int32_t* parent = parent_.data();
+    remap[0] = 0;
+    count_ = 0;
+    for (std::int32_t l = 1; l < next; ++l) {
+      remap[l] = parent[l] == l ? ++count_ : remap[parent[l]];
+    }
+    return remap;
   }
 
   std::int32_t find(std::int32_t l) noexcept {
