@@ -245,6 +245,31 @@ TEST_CASE("components agree with a union-find oracle, bwareaopen", "[image]") {
   }
 }
 
+TEST_CASE("components: full rows and stripes at the 64-column word boundary", "[image]") {
+  ti::Components comp;
+  for (const Eigen::Index cols : {62, 63, 64, 65}) {
+    for (int pattern = 0; pattern < 4; ++pattern) {
+      ti::Mask m(5, cols);
+      for (Eigen::Index r = 0; r < m.rows(); ++r) {
+        for (Eigen::Index c = 0; c < cols; ++c) {
+          const bool on = pattern == 0   ? true                         // all set
+                          : pattern == 1 ? (r + c) % 2 == 0             // checkerboard
+                          : pattern == 2 ? c == cols - 1 || r % 2 == 0  // comb
+                                         : c % 3 != 1;                  // stripes
+          m(r, c) = on ? 1 : 0;
+        }
+      }
+      for (const auto conn : {ti::Connectivity::four, ti::Connectivity::eight}) {
+        const bool eight = conn == ti::Connectivity::eight;
+        CHECK(comp.compute(m, conn) == count_components(m, 1, eight, false));
+        long total = 0;
+        for (int id = 1; id <= comp.count(); ++id) total += comp.area(id);
+        CHECK(total == (m != 0).count());
+      }
+    }
+  }
+}
+
 TEST_CASE("region descriptors agree with brute force on random masks", "[image]") {
   std::mt19937 rng(11);
   ti::RegionAnalyzer a({}, 16, 16);
