@@ -569,6 +569,41 @@ ti::ImageD palm_image(bool sharp_edge) {
 }
 }  // namespace
 
+TEST_CASE("k-means: few and many distinct values (hash merge and sort) both exact", "[image]") {
+  // Up to n / 4 + 16 distinct values are merged through a hash table, more by sorting; both
+  // must give the exhaustive optimum and the histogram path's clustering.
+  std::mt19937 rng(41);
+  for (int trial = 0; trial < 12; ++trial) {
+    const std::size_t n = 120 + 20 * static_cast<std::size_t>(trial);
+    const int levels = trial % 3 == 0 ? 5 : trial % 3 == 1 ? 40 : 5000;  // few .. all distinct
+    std::uniform_int_distribution<int> level(0, levels - 1);
+    std::vector<double> v(n);
+    for (double& x : v) x = level(rng);
+    for (const int k : {2, 3}) {
+      ti::KMeans1d solver(k, n);
+      const ti::KMeans1dResult r = solver.fit(v);
+      REQUIRE(r.ok());
+      if (n <= 200) CHECK(r.sse == Approx(exhaustive_sse(v, r.k)).margin(1e-9));
+      std::vector<std::uint32_t> hist(static_cast<std::size_t>(levels), 0);
+      for (double x : v) ++hist[static_cast<std::size_t>(x)];
+      ti::KMeans1d by_hist(k);
+      const ti::KMeans1dResult& h = by_hist.fit_histogram(hist);
+      CHECK(h.centroids == r.centroids);
+      CHECK(h.sizes == r.sizes);
+      CHECK(h.sse == Approx(r.sse).margin(1e-9));
+      // Scaled to non-integers (a calibrated sensor): the same partition.
+      std::vector<double> scaled = v;
+      for (double& x : scaled) x = 0.0137 * x + 0.001;
+      const ti::KMeans1dResult sc = solver.fit(scaled);
+      CHECK(sc.sizes == r.sizes);
+    }
+  }
+  // -0 and +0 are one value.
+  const ti::KMeans1dResult z = ti::kmeans1d(std::vector<double>{-0.0, 0.0, 0.0, 5.0, 9.0}, 3);
+  CHECK(z.k == 3);
+  CHECK(z.sizes[0] == 3);
+}
+
 TEST_CASE("segmentation: classes, polarity, small regions, degenerate images", "[image]") {
   const ti::ImageD img = palm_image(true);
   const ti::Segmentation s = ti::segment(img);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -41,7 +42,8 @@ struct KMeans1dResult : Outcome {
   }
 };
 
-/// Exact 1-D k-means workspace: sorts, merges equal values, then solves
+/// Exact 1-D k-means workspace: merges equal values (through a hash table when there are few
+/// distinct ones, by sorting otherwise), then solves
 /// D_c(j) = min_i D_{c-1}(i-1) + SSE(i..j) by divide and conquer over monotone split points
 /// (O(k m log m) for m distinct values; the last layer is a single O(m) scan). Buffers are kept
 /// between calls, so fitting images of the same size allocates nothing after the first call.
@@ -62,6 +64,9 @@ class KMeans1d {
 
   /// Preallocates for up to `n` values.
   void reserve(std::size_t n) {
+    keys_.reserve(std::bit_ceil(2 * few_cap(n)));
+    counts_.reserve(std::bit_ceil(2 * few_cap(n)));
+    few_.reserve(few_cap(n));
     sorted_.reserve(n);
     value_.reserve(n);
     weight_.reserve(n);
@@ -79,10 +84,11 @@ class KMeans1d {
   /// The exact clustering of `values`. Empty input or a non-finite value gives
   /// `invalid_input` (k = 0).
   const KMeans1dResult& fit(std::span<const double> values) {
-    sorted_.assign(values.begin(), values.end());
-    for (double v : sorted_) {
+    for (double v : values) {
       if (!std::isfinite(v)) return fail("a value is not finite");
     }
+    if (merge_few(values)) return solve();
+    sorted_.assign(values.begin(), values.end());
     std::sort(sorted_.begin(), sorted_.end());
     value_.clear();
     weight_.clear();
@@ -127,6 +133,45 @@ class KMeans1d {
     result_.iterations = 0;
     return result_;
   }
+
+  // Data with few distinct values (scaled sensor counts, quantised images): equal values are
+  // merged in a small open-addressing table and only the distinct ones are sorted, instead of
+  // sorting every value. Gives up (false) once more than n / 4 + 16 distinct values appear,
+  // leaving the sort to `fit`. Fills value_ and weight_ as the sort would.
+  bool merge_few(std::span<const double> values) {
+    const std::size_t cap = few_cap(values.size());
+    const std::size_t size = std::bit_ceil(2 * cap);
+    const int shift = 64 - std::countr_zero(size);
+    keys_.assign(size, kEmptyKey);
+    counts_.assign(size, 0);
+    std::uint64_t* keys = keys_.data();
+    std::uint32_t* counts = counts_.data();
+    std::size_t distinct = 0;
+    for (const double v : values) {
+      const std::uint64_t bits = std::bit_cast<std::uint64_t>(v + 0.0);  // -0 and +0: one key
+      std::size_t i = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ULL) >> shift);
+      while (keys[i] != bits && keys[i] != kEmptyKey) i = (i + 1) & (size - 1);
+      if (keys[i] == kEmptyKey) {
+        if (++distinct > cap) return false;
+        keys[i] = bits;
+      }
+      ++counts[i];
+    }
+    few_.clear();
+    for (std::size_t i = 0; i < size; ++i) {
+      if (keys[i] != kEmptyKey) few_.push_back({std::bit_cast<double>(keys[i]), counts[i]});
+    }
+    std::sort(few_.begin(), few_.end(),
+              [](const Distinct& a, const Distinct& b) { return a.value < b.value; });
+    value_.clear();
+    weight_.clear();
+    for (const Distinct& d : few_) {
+      value_.push_back(d.value);
+      weight_.push_back(static_cast<double>(d.count));
+    }
+    return true;
+  }
+  static std::size_t few_cap(std::size_t n) noexcept { return n / 4 + 16; }
 
   // SSE of distinct values a..b inclusive, from prefix sums of shifted values.
   [[nodiscard]] double cost(std::size_t a, std::size_t b) const noexcept {
@@ -234,7 +279,17 @@ class KMeans1d {
     return result_;
   }
 
+  struct Distinct {
+    double value;
+    std::uint32_t count;
+  };
+  // A NaN pattern: never the bits of a finite value.
+  static constexpr std::uint64_t kEmptyKey = 0x7FF8000000000001ULL;
+
   int k_;
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint32_t> counts_;
+  std::vector<Distinct> few_;
   std::vector<double> sorted_, value_, weight_;
   std::vector<double> prefix_w_, prefix_s_, prefix_q_;
   std::vector<double> prev_, cur_;

@@ -79,6 +79,7 @@ class Segmenter {
     level_value_.reserve(histogram_.capacity());
     levels_.reserve(static_cast<std::size_t>(rows * cols));
     split_.reserve(4 * std::min(kSplitHistogramLevels, histogram_.capacity()));
+    bounds_.reserve(static_cast<std::size_t>(cfg.k));
   }
 
   /// The configuration.
@@ -236,9 +237,20 @@ class Segmenter {
         high_raw[i] = cls == utop ? 1 : 0;
       }
     } else {
+      // cluster_of without branches: the number of cluster boundaries below the value.
+      bounds_.clear();
+      for (int c = 0; c + 1 < km.k; ++c) {
+        const auto i = static_cast<std::size_t>(c);
+        bounds_.push_back(0.5 * (km.upper[i] + km.lower[i + 1]));
+      }
+      const double* bounds = bounds_.data();
+      const std::size_t nb = bounds_.size();
       for (Eigen::Index r = 0; r < rows; ++r) {
+        const double* row = img.data() + r * stride;
         for (Eigen::Index c = 0; c < cols; ++c) {
-          const int cl = km.cluster_of(sign * img(r, c));
+          const double v = sign * row[c];
+          int cl = 0;
+          for (std::size_t b = 0; b < nb; ++b) cl += v > bounds[b] ? 1 : 0;
           const int cls = class_of_cluster(cl);
           const Eigen::Index i = r * cols + c;
           classes[i] = static_cast<std::uint8_t>(cls);
@@ -285,6 +297,7 @@ class Segmenter {
   std::vector<double> level_value_;
   std::vector<std::int32_t> levels_;
   std::vector<std::uint32_t> split_;
+  std::vector<double> bounds_;
   static constexpr std::size_t kSplitHistogramLevels = 4096;
 };
 
