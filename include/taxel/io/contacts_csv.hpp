@@ -45,17 +45,12 @@ inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
   where.fill(-1);
   int columns = 0;
   bool have_header = false;
-  std::uint64_t line_no = 0;
   std::vector<std::string_view> cells;
-  for (std::size_t pos = 0; pos < text.size();) {
-    const std::size_t nl = text.find('\n', pos);
-    const std::size_t end = nl == std::string_view::npos ? text.size() : nl;
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    const auto first = line.find_first_not_of(" \t");
-    if (first == std::string_view::npos || line[first] == '#') continue;
+  LineReader lines(text);
+  std::string_view line;
+  while (lines.next(line)) {
+    const std::uint64_t line_no = lines.line_number();
+    if (blank_or_comment(line)) continue;
     cells.clear();
     for (std::size_t c = 0;;) {
       const std::size_t comma = line.find(',', c);

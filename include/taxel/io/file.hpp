@@ -13,6 +13,40 @@
 
 namespace taxel::io {
 
+/// Splits text into lines ending in LF or CRLF (the line ending is not part of a line) and
+/// counts them from 1; the last line may lack its ending. The text readers share it.
+class LineReader {
+ public:
+  explicit LineReader(std::string_view text) noexcept : text_(text) {}
+
+  /// The next line; false once the text is used up.
+  bool next(std::string_view& line) noexcept {
+    if (pos_ >= text_.size()) return false;
+    const std::size_t nl = text_.find('\n', pos_);
+    const std::size_t end = nl == std::string_view::npos ? text_.size() : nl;
+    line = text_.substr(pos_, end - pos_);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    pos_ = nl == std::string_view::npos ? text_.size() : nl + 1;
+    ++number_;
+    return true;
+  }
+  /// Number of the line `next` returned last (0 before the first).
+  [[nodiscard]] std::uint64_t line_number() const noexcept { return number_; }
+  /// Offset of the byte after the last line returned (where binary data may follow).
+  [[nodiscard]] std::size_t offset() const noexcept { return pos_; }
+
+ private:
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  std::uint64_t number_ = 0;
+};
+
+/// True for a line that is empty, blank, or whose first non-blank character is '#'.
+inline bool blank_or_comment(std::string_view line) noexcept {
+  const auto first = line.find_first_not_of(" \t");
+  return first == std::string_view::npos || line[first] == '#';
+}
+
 /// Largest file the readers accept (1 GiB); larger inputs are refused, not read.
 inline constexpr std::uint64_t kMaxFileBytes = std::uint64_t{1} << 30;
 

@@ -67,16 +67,11 @@ inline void check_size(const std::string& source, std::uint64_t frames, std::uin
 inline ImageStack parse_image_csv(std::string_view text, const std::string& source = "<csv>") {
   ImageStack out;
   out.frames = 1;
-  std::uint64_t line_no = 0;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    const std::size_t end = std::min(text.find('\n', pos), text.size());
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    const auto first = line.find_first_not_of(" \t");
-    if (first == std::string_view::npos || line[first] == '#') continue;
+  LineReader lines(text);
+  std::string_view line;
+  while (lines.next(line)) {
+    const std::uint64_t line_no = lines.line_number();
+    if (blank_or_comment(line)) continue;
     Eigen::Index cols = 0;
     std::size_t i = 0;
     while (true) {

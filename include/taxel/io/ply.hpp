@@ -197,16 +197,11 @@ class PlyBody {
 /// hold, truncation, malformed or non-finite numbers, face indices out of range, trailing data.
 inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<ply>") {
   using namespace detail;
-  std::size_t pos = 0;
+  LineReader header(bytes);
   std::uint64_t line = 0;
   const auto next_line = [&](std::string_view& out) {
-    if (pos >= bytes.size()) throw IoError(source, "the header has no end_header line", line + 1);
-    const std::size_t nl = bytes.find('\n', pos);
-    const std::size_t end = nl == std::string_view::npos ? bytes.size() : nl;
-    out = bytes.substr(pos, end - pos);
-    if (!out.empty() && out.back() == '\r') out.remove_suffix(1);
-    pos = nl == std::string_view::npos ? bytes.size() : nl + 1;
-    ++line;
+    if (!header.next(out)) throw IoError(source, "the header has no end_header line", line + 1);
+    line = header.line_number();
   };
   const auto words = [](std::string_view s) {
     std::vector<std::string_view> w;
@@ -279,7 +274,7 @@ inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<p
   if (!have_format) throw IoError(source, "the header has no format line", line);
 
   PlyData out;
-  PlyBody body(bytes, pos, line + 1, binary, source);
+  PlyBody body(bytes, header.offset(), line + 1, binary, source);
   bool seen_vertex = false;
   for (const PlyElement& e : elements) {
     // Every value takes at least one byte (or its size in binary): refuse counts the

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "taxel/drivers/transport.hpp"
+#include "taxel/io/file.hpp"
 
 namespace taxel::drivers {
 
@@ -48,19 +49,16 @@ struct SessionError : std::runtime_error {
 inline std::vector<SessionChunk> parse_session(std::string_view text,
                                                const std::string& source = "<session>") {
   std::vector<SessionChunk> out;
-  std::size_t line_no = 0, pos = 0;
+  std::uint64_t line_no = 0;
   bool header = false;
   double last_time = 0.0;
   const auto fail = [&](const std::string& why) {
     throw SessionError(source + ":" + std::to_string(line_no) + ": " + why);
   };
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  io::LineReader lines(text);
+  std::string_view line;
+  while (lines.next(line)) {
+    line_no = lines.line_number();
     if (line.empty() || line.front() == '#') continue;
     if (!header) {
       if (line != "taxel-session 1") fail("expected the header 'taxel-session 1'");
