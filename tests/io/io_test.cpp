@@ -357,6 +357,28 @@ TEST_CASE("PLY: ASCII and binary round trips, foreign files, strict errors", "[i
     INFO(text);
     CHECK_THROWS_WITH(tio::parse_ply(text), Contains(message));
   }
+  // Elements without properties (found by fuzzing: a declared count of 2e9 was walked entry by
+  // entry). In binary they hold no bytes and are skipped whatever their count; in ASCII each
+  // entry is a line, so the count is bounded by the file.
+  {
+    const std::string binary =
+        std::string(
+            "ply\nformat binary_little_endian 1.0\nelement marker 4000000000\n"
+            "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+            "end_header\n") +
+        std::string(12, '\0');
+    const auto d = tio::parse_ply(binary);
+    REQUIRE(d.cloud.size() == 1);
+    CHECK(d.cloud.points[0] == taxel::Vec3d::Zero());
+    CHECK_THROWS_WITH(tio::parse_ply("ply\nformat ascii 1.0\nelement marker 4000000000\n"
+                                     "end_header\n\n\n"),
+                      Contains("declares 4000000000 entries"));
+    const auto ascii = tio::parse_ply(
+        "ply\nformat ascii 1.0\nelement marker 2\nelement vertex 1\nproperty double x\n"
+        "property double y\nproperty double z\nend_header\n\n\n1 2 3\n");
+    REQUIRE(ascii.cloud.size() == 1);
+    CHECK(ascii.cloud.points[0] == taxel::Vec3d(1, 2, 3));
+  }
   CHECK_THROWS_WITH(tio::read_ply("/nonexistent/x.ply"), Contains("cannot open"));
   taxel::PointCloud<double> nan_cloud;
   nan_cloud.points.emplace_back(std::nan(""), 0.0, 0.0);
