@@ -201,6 +201,63 @@ TEMPLATE_TEST_CASE("Kalman covariance stays symmetric positive definite over 10^
   }
 }
 
+TEMPLATE_TEST_CASE("Kalman update equals the textbook matrix form with correlated P and R",
+                   "[fusion]", float, double) {
+  // Oracle: the update written with general matrices in long double, Eigen's LU inverse.
+  using S = TestType;
+  using L = long double;
+  using ML = Eigen::Matrix<L, 3, 3>;
+  using VL = Eigen::Matrix<L, 3, 1>;
+  std::mt19937 rng(29);
+  std::normal_distribution<double> g(0.0, 1.0);
+  auto random_spd = [&](double scale) {
+    Eigen::Matrix3d a;
+    for (int i = 0; i < 9; ++i) a.data()[i] = g(rng);
+    const Eigen::Matrix3d m = (a * a.transpose() + 0.1 * Eigen::Matrix3d::Identity()) * scale;
+    return taxel::Mat3<S>(m.cast<S>());
+  };
+  const S tol = std::is_same_v<S, float> ? S(2e-4) : S(1e-11);
+  for (int trial = 0; trial < 200; ++trial) {
+    const S q = trial % 2 ? S(0) : S(3e-4);
+    tf::Kalman<S> kalman({.process_noise = q});
+    typename tf::Kalman<S>::State s{taxel::Vec3<S>(S(g(rng)), S(g(rng)), S(g(rng))) * S(1e-2),
+                                    random_spd(1e-6)};
+    const auto c = contact_at<S>(s.mean + taxel::Vec3<S>(S(g(rng)), S(g(rng)), S(g(rng))) * S(1e-3),
+                                 random_spd(1e-6));
+    const ML pm = s.covariance.template cast<L>() + ML::Identity() * (L(q) * L(q));
+    const ML r = c.covariance.template cast<L>();
+    const ML k = pm * (pm + r).inverse();
+    const VL mean =
+        s.mean.template cast<L>() + k * (c.position.template cast<L>() - s.mean.template cast<L>());
+    const ML a = ML::Identity() - k;
+    const ML p = a * pm * a.transpose() + k * r * k.transpose();
+    REQUIRE(kalman.fuse(s, c, 1));
+    INFO("trial " << trial);
+    CHECK((s.mean.template cast<L>() - mean).norm() <= L(tol) * (1e-2L + mean.norm()));
+    CHECK((s.covariance.template cast<L>() - p).norm() <= L(tol) * p.norm());
+    CHECK(s.covariance == s.covariance.transpose());
+  }
+}
+
+TEMPLATE_TEST_CASE("the Mahalanobis gate compares the textbook distance with the threshold",
+                   "[fusion]", float, double) {
+  using S = TestType;
+  const taxel::Mat3<S> p = taxel::pad_covariance<S>({0, 0, 1}, S(1e-3), S(2e-3));
+  const taxel::Mat3<S> r =
+      taxel::pad_covariance<S>(taxel::Vec3<S>(S(1), S(1), S(1)).normalized(), S(0.5e-3), S(1.5e-3));
+  const auto c = contact_at<S>(taxel::Vec3<S>(S(2e-3), S(-1e-3), S(3e-3)), r);
+  const double d2 = c.position.template cast<double>().dot(
+      (p + r).template cast<double>().inverse() * c.position.template cast<double>());
+  for (const double factor : {0.99, 1.01}) {
+    tf::Kalman<S> kalman({.gate_chi2 = S(d2 * factor)});
+    typename tf::Kalman<S>::State s{taxel::Vec3<S>::Zero(), p};
+    const auto before = s.covariance;
+    INFO("threshold " << factor << " x " << d2);
+    CHECK(kalman.fuse(s, c, 1) == (factor > 1));
+    if (factor < 1) CHECK((s.covariance == before && s.mean.isZero()));
+  }
+}
+
 TEST_CASE("the Mahalanobis gate refuses contacts the covariance rules out", "[fusion]") {
   using Cloud = tf::ContactCloud<tf::Kalman<double>>;
   Cloud gated({.association_radius = 5e-3, .fusion = {.gate_chi2 = tf::kChi2Dof3P99}});

@@ -8,8 +8,6 @@
 #include <stdexcept>
 #include <string>
 
-#include <Eigen/LU>
-
 #include "taxel/core/contact.hpp"
 
 namespace taxel::fusion {
@@ -73,39 +71,56 @@ struct Kalman {
   }
 
   /// One Kalman update; false (state untouched) when the Mahalanobis gate refuses.
-  /// Written on the symmetric 3x3 entries: the innovation covariance is inverted by its
-  /// adjugate, and of the Joseph form only the upper triangle is formed, then mirrored.
+  /// Written in scalars on the symmetric 3x3 entries: the innovation covariance is inverted
+  /// by its adjugate, the gain is scaled by 1/det last (so the division overlaps the
+  /// product), and of the Joseph form only the upper triangle is formed, then mirrored.
   bool fuse(State& s, const Contact<S>& c, std::uint32_t) const {
-    Mat3<S> pp = s.covariance;
-    if (config_.process_noise > S(0)) {
-      pp.diagonal().array() += config_.process_noise * config_.process_noise;
-    }
     const Mat3<S>& r = c.covariance;
-    // Innovation covariance (symmetric) and its inverse.
-    const S a = pp(0, 0) + r(0, 0), b = pp(0, 1) + r(0, 1), cc = pp(0, 2) + r(0, 2);
-    const S d = pp(1, 1) + r(1, 1), e = pp(1, 2) + r(1, 2), f = pp(2, 2) + r(2, 2);
-    const S i00 = d * f - e * e, i01 = cc * e - b * f, i02 = b * e - cc * d;
-    const S i11 = a * f - cc * cc, i12 = b * cc - a * e, i22 = a * d - b * b;
-    const S inv_det = S(1) / (a * i00 + b * i01 + cc * i02);
-    Mat3<S> si;
-    si << i00 * inv_det, i01 * inv_det, i02 * inv_det,  //
-        i01 * inv_det, i11 * inv_det, i12 * inv_det,    //
-        i02 * inv_det, i12 * inv_det, i22 * inv_det;
-    const Vec3<S> innovation = c.position - s.mean;
-    if (config_.gate_chi2 && innovation.dot(si * innovation) > *config_.gate_chi2) return false;
-    const Mat3<S> gain = pp * si;
-    s.mean += gain * innovation;
-    // Joseph form (I - K) P- (I - K)' + K R K', upper triangle: with B = (I - K) P- and
-    // C = K R, entry (i, j) is B(i, j) - B.row(i) . K.row(j) + C.row(i) . K.row(j).
-    const Mat3<S> bm = pp - gain * pp;
-    const Mat3<S> cm = gain * r;
-    const Mat3<S> diff = cm - bm;  // (C - B)
-    Mat3<S>& out = s.covariance;
+    Mat3<S>& pm = s.covariance;
+    const S q2 = config_.process_noise * config_.process_noise;
+    // Predicted covariance P- (symmetric: the upper triangle is read).
+    S p[3][3];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = i; j < 3; ++j) p[i][j] = p[j][i] = pm(i, j) + (i == j ? q2 : S(0));
+    }
+    // Innovation covariance (symmetric), its adjugate and determinant.
+    const S a = p[0][0] + r(0, 0), b = p[0][1] + r(0, 1), cc = p[0][2] + r(0, 2);
+    const S d = p[1][1] + r(1, 1), e = p[1][2] + r(1, 2), f = p[2][2] + r(2, 2);
+    const S adj[3][3] = {{d * f - e * e, cc * e - b * f, b * e - cc * d},
+                         {cc * e - b * f, a * f - cc * cc, b * cc - a * e},
+                         {b * e - cc * d, b * cc - a * e, a * d - b * b}};
+    const S inv_det = S(1) / (a * adj[0][0] + b * adj[0][1] + cc * adj[0][2]);
+    const S v[3] = {c.position.x() - s.mean.x(), c.position.y() - s.mean.y(),
+                    c.position.z() - s.mean.z()};
+    if (config_.gate_chi2) {
+      S m2 = S(0);
+      for (int i = 0; i < 3; ++i) {
+        m2 += v[i] * (adj[i][0] * v[0] + adj[i][1] * v[1] + adj[i][2] * v[2]);
+      }
+      if (m2 * inv_det > *config_.gate_chi2) return false;
+    }
+    // Gain K = P- adj / det (the product runs alongside the division).
+    S k[3][3];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        k[i][j] = (p[i][0] * adj[0][j] + p[i][1] * adj[1][j] + p[i][2] * adj[2][j]) * inv_det;
+      }
+    }
+    for (int i = 0; i < 3; ++i) s.mean[i] += k[i][0] * v[0] + k[i][1] * v[1] + k[i][2] * v[2];
+    // Joseph form (I - K) P- (I - K)' + K R K', upper triangle: with T = (I - K) P- and
+    // U = K R, entry (i, j) is T(i, j) + (U - T).row(i) . K.row(j).
+    S t[3][3], w[3][3];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        t[i][j] = p[i][j] - (k[i][0] * p[0][j] + k[i][1] * p[1][j] + k[i][2] * p[2][j]);
+        w[i][j] = k[i][0] * r(0, j) + k[i][1] * r(1, j) + k[i][2] * r(2, j) - t[i][j];
+      }
+    }
     for (int i = 0; i < 3; ++i) {
       for (int j = i; j < 3; ++j) {
-        const S v = bm(i, j) + diff.row(i).dot(gain.row(j));
-        out(i, j) = v;
-        out(j, i) = v;
+        const S val = t[i][j] + w[i][0] * k[j][0] + w[i][1] * k[j][1] + w[i][2] * k[j][2];
+        pm(i, j) = val;
+        pm(j, i) = val;
       }
     }
     return true;
