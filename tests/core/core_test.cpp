@@ -80,6 +80,16 @@ TEST_CASE("check_contact names each defect of a contact") {
         }) == D::indefinite_covariance);
   CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, 0, 2); }) == D::bad_normal);
   CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, 0, 1); }) == D::ok);
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(nan, 0, 1); }) == D::bad_normal);
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, inf, 0); }) == D::bad_normal);
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(1e200, 0, 0); }) == D::bad_normal);
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, 0, 0); }) == D::bad_normal);
+  // The unit-length tolerance is 1e-3 on |n|, either side.
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, 0.6 * 1.0009, 0.8 * 1.0009); }) == D::ok);
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, 0, 0.9991); }) == D::ok);
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, 0.6 * 1.0011, 0.8 * 1.0011); }) ==
+        D::bad_normal);
+  CHECK(with([&](auto& d) { d.normal = taxel::Vec3d(0, 0, 0.9989); }) == D::bad_normal);
   // Rounding-level asymmetry is tolerated.
   CHECK(with([&](auto& d) { d.covariance(0, 1) = 1e-22; }) == D::ok);
   CHECK(taxel::to_string(D::indefinite_covariance) == "covariance is not positive definite");

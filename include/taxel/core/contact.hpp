@@ -97,6 +97,15 @@ constexpr std::string_view to_string(ContactDefect d) noexcept {
   return "unknown";
 }
 
+namespace detail {
+/// Sylvester's criterion on a matrix already known to be symmetric.
+template <Scalar S>
+bool leading_minors_positive(const Mat3<S>& m) noexcept {
+  const S minor2 = m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0);
+  return m(0, 0) > S(0) && minor2 > S(0) && m.determinant() > S(0);
+}
+}  // namespace detail
+
 /// True when `m` equals its transpose to within 64 ulps of its largest entry.
 template <Scalar S>
 bool is_symmetric(const Mat3<S>& m) noexcept {
@@ -111,9 +120,7 @@ bool is_symmetric(const Mat3<S>& m) noexcept {
 /// criterion (all leading principal minors > 0). O(1), no allocation.
 template <Scalar S>
 bool is_symmetric_positive_definite(const Mat3<S>& m) noexcept {
-  if (!is_symmetric(m)) return false;
-  const S minor2 = m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0);
-  return m(0, 0) > S(0) && minor2 > S(0) && m.determinant() > S(0);
+  return is_symmetric(m) && detail::leading_minors_positive(m);
 }
 
 /// Checks a contact for the defects that would corrupt a model fed with it. O(1).
@@ -122,9 +129,11 @@ ContactDefect check_contact(const Contact<S>& c) noexcept {
   if (!all_finite(c.position)) return ContactDefect::non_finite_position;
   if (!all_finite(c.covariance)) return ContactDefect::non_finite_covariance;
   if (!is_symmetric(c.covariance)) return ContactDefect::asymmetric_covariance;
-  if (!is_symmetric_positive_definite(c.covariance)) return ContactDefect::indefinite_covariance;
-  if (c.normal && (!all_finite(*c.normal) || std::abs(c.normal->norm() - S(1)) > S(1e-3))) {
-    return ContactDefect::bad_normal;
+  if (!detail::leading_minors_positive(c.covariance)) return ContactDefect::indefinite_covariance;
+  if (c.normal) {
+    // |n| within 1e-3 of 1, on the squared norm; NaN and Inf fail the comparison.
+    const S n2 = c.normal->squaredNorm();
+    if (!(n2 >= S(0.999 * 0.999) && n2 <= S(1.001 * 1.001))) return ContactDefect::bad_normal;
   }
   return ContactDefect::ok;
 }
