@@ -43,7 +43,8 @@ class VoxelHash {
     /// query finds empty (half of the neighbours on a surface); 16-byte slots make it cheap.
     double max_load_factor = 0.25;
   };
-  /// Points per block: a block fits in two 64-byte cache lines.
+  /// Points per block: a block (its chain link, cell and points) fills two 64-byte cache
+  /// lines.
   static constexpr std::uint32_t kBlockCapacity = sizeof(S) == 8 ? 4 : 7;
 
   /// `radius` [m]: the query radius served by a 2x2x2 block of cells (the association radius).
@@ -82,7 +83,7 @@ class VoxelHash {
     TAXEL_ASSERT(all_finite(p), "VoxelHash::move: point is not finite");
     const Loc at = loc_[id];
     Block& b = blocks_[at.block];
-    const Key old_key = key_of(Vec3<S>(b.x[at.lane], b.y[at.lane], b.z[at.lane]));
+    const Key old_key = b.key;
     const Key new_key = key_of(p);
     if (old_key == new_key) {
       b.x[at.lane] = p.x();
@@ -98,8 +99,7 @@ class VoxelHash {
   void erase(PointId id) {
     TAXEL_ASSERT(contains(id), "VoxelHash::erase: id not stored");
     const Loc at = loc_[id];
-    const Block& b = blocks_[at.block];
-    unlink(id, key_of(Vec3<S>(b.x[at.lane], b.y[at.lane], b.z[at.lane])));
+    unlink(id, blocks_[at.block].key);
     --size_;
   }
 
@@ -182,7 +182,7 @@ class VoxelHash {
     if (size_ == 0 || !all_finite(q) || !(r >= S(0))) return out;
     const S r2 = r * r;
     auto visit = [&](const Block& b) {
-      for (std::uint32_t l = 0; l < b.count; ++l) {
+      for (std::uint32_t l = 0; l < kBlockCapacity; ++l) {
         const S d2 = squared_distance(Vec3<S>(b.x[l], b.y[l], b.z[l]), q);
         if (d2 <= r2) out.push_back({b.ids[l], d2});
       }
@@ -238,10 +238,11 @@ class VoxelHash {
     std::uint32_t head = kNone;  // kNone: never used (ends a probe run)
   };
   // Unused lanes hold +inf coordinates, so a scan over all lanes needs no count check and
-  // an unused lane is never within any radius.
-  struct Block {
-    std::uint32_t count = 0;
+  // an unused lane is never within any radius; the used lanes are a prefix. A block knows its
+  // cell, so a move needs no floor of the old position. 128 bytes, on cache-line boundaries.
+  struct alignas(64) Block {
     std::uint32_t next = kNone;
+    Key key;
     PointId ids[kBlockCapacity] = {};
     S x[kBlockCapacity], y[kBlockCapacity], z[kBlockCapacity];
     Block() noexcept { clear_lanes(0); }
@@ -251,6 +252,7 @@ class VoxelHash {
       }
     }
   };
+  static_assert(sizeof(Block) == 128);
   struct Loc {
     std::uint32_t block = kNone;
     std::uint32_t lane = 0;
@@ -310,6 +312,7 @@ class VoxelHash {
       if (s.head == kNone) {
         s.key = k;
         s.head = new_block();
+        blocks_[s.head].key = k;
         ++cells_;
         return s;
       }
@@ -331,7 +334,6 @@ class VoxelHash {
     if (!free_blocks_.empty()) {
       const std::uint32_t b = free_blocks_.back();
       free_blocks_.pop_back();
-      blocks_[b].count = 0;
       blocks_[b].next = kNone;
       blocks_[b].clear_lanes(0);
       return b;
@@ -344,13 +346,14 @@ class VoxelHash {
     // Invariant: in a cell's chain only the head block may be partly filled.
     Slot* slot = &find_or_add(key);
     std::uint32_t bi = slot->head;
-    if (blocks_[bi].count == kBlockCapacity) {
+    if (count_of(blocks_[bi]) == kBlockCapacity) {
       bi = new_block();  // may reallocate blocks_, never slots_
       blocks_[bi].next = slot->head;
+      blocks_[bi].key = key;
       slot->head = bi;
     }
     Block& b = blocks_[bi];
-    const std::uint32_t l = b.count++;
+    const std::uint32_t l = count_of(b);
     b.ids[l] = id;
     b.x[l] = p.x();
     b.y[l] = p.y();
@@ -358,6 +361,12 @@ class VoxelHash {
     loc_[id] = {bi, l};
   }
 
+  // Points in a block: its filled lanes are a prefix, the others hold +inf.
+  static std::uint32_t count_of(const Block& b) noexcept {
+    std::uint32_t n = 0;
+    while (n < kBlockCapacity && b.x[n] != std::numeric_limits<S>::infinity()) ++n;
+    return n;
+  }
   // Takes `id` out of cell `key`, filling its lane with the last point of the cell's head
   // block (keeping only the head partly filled); frees the head when it empties and is not
   // the cell's only block.
@@ -368,7 +377,7 @@ class VoxelHash {
     Slot& slot = slots_[i];
     const Loc at = loc_[id];
     Block& head = blocks_[slot.head];
-    const std::uint32_t last = --head.count;
+    const std::uint32_t last = count_of(head) - 1;
     if (slot.head != at.block || at.lane != last) {
       Block& b = blocks_[at.block];
       b.ids[at.lane] = head.ids[last];
@@ -379,7 +388,7 @@ class VoxelHash {
     }
     head.clear_lanes(last);
     loc_[id] = Loc{};
-    if (head.count == 0 && head.next != kNone) {
+    if (last == 0 && head.next != kNone) {
       const std::uint32_t freed = slot.head;
       slot.head = head.next;
       head.next = kNone;
