@@ -23,16 +23,18 @@ namespace taxel::index {
 /// Cells are cubes of side 2r for the radius r given at construction, so a ball of radius
 /// <= r meets at most a 2x2x2 block of cells; the cell holding the query is read first and
 /// the others only when they can still hold a closer point. Layout is flat: an open-addressing
-/// table (linear probing, 16-byte slots) maps a cell to a chain of fixed-size blocks in one
-/// pool; a block holds up to kBlockCapacity points (ids and coordinates side by side). There
-/// are no per-cell heap containers, and `move` within a cell rewrites the coordinates in place.
-/// Larger radii and k-NN queries work too (exactly), by visiting more cells.
+/// table (multiplicative hashing, linear probing, 16-byte slots) maps a cell to a chain of
+/// fixed-size 128-byte blocks in one pool; a block holds up to kBlockCapacity points (ids and
+/// coordinates side by side). There are no per-cell heap containers, and `move` within a cell
+/// rewrites the coordinates in place. Larger radii and k-NN queries work too (exactly), by
+/// visiting more cells.
 ///
 /// Complexity: nearest_within(q, r_cfg) reads <= 8 cells; insert/move/erase are O(1) amortised
-/// (a move across cells touches two cells). Memory: see `memory_bytes()`; about 60-90 bytes per
-/// point for double at the densities of fused tactile clouds. No allocation in `move` within a
-/// cell or in `nearest_within`. Coordinates beyond 2^30 cells from the origin share the
-/// outermost cells (still exact, slower). Const queries may run concurrently; writes may not.
+/// (a move across cells touches two cells). Memory: see `memory_bytes()`; 110-140 bytes per
+/// point for double, 70-90 for float, on the fused clouds of fusion_bench (growth slack of
+/// the pools included). No allocation in `move` within a cell or in `nearest_within`.
+/// Coordinates beyond 2^30 cells from the origin share the outermost cells (still exact,
+/// slower). Const queries may run concurrently; writes may not.
 template <Scalar S>
 class VoxelHash {
  public:
@@ -63,6 +65,7 @@ class VoxelHash {
     cell_ = S(2) * radius * (S(1) + kMargin);
     inv_cell_ = S(1) / cell_;
     slots_.assign(16, Slot{});
+    shift_ = 60;
   }
 
   /// Side of a cell [m].
@@ -283,19 +286,18 @@ class VoxelHash {
     return std::max(S(0), gap - slack);
   }
 
-  static std::uint64_t hash(const Key& k) noexcept {
-    std::uint64_t h = std::uint64_t(std::uint32_t(k.x)) * 0x9E3779B97F4A7C15ULL;
-    h ^= std::uint64_t(std::uint32_t(k.y)) * 0xC2B2AE3D27D4EB4FULL;
-    h ^= std::uint64_t(std::uint32_t(k.z)) * 0x165667B19E3779F9ULL;
-    h ^= h >> 29;
-    h *= 0xBF58476D1CE4E5B9ULL;
-    return h ^ (h >> 32);
+  // Multiplicative (Fibonacci) hashing: the slot is the top bits of a 64-bit product sum.
+  std::size_t home_slot(const Key& k) const noexcept {
+    const std::uint64_t h = std::uint64_t(std::uint32_t(k.x)) * 0x9E3779B97F4A7C15ULL +
+                            std::uint64_t(std::uint32_t(k.y)) * 0xC2B2AE3D27D4EB4FULL +
+                            std::uint64_t(std::uint32_t(k.z)) * 0x165667B19E3779F9ULL;
+    return static_cast<std::size_t>(h >> shift_);
   }
 
   // Head block of cell `k`, or kNone.
   std::uint32_t find(const Key& k) const noexcept {
     const std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(k) & mask;; i = (i + 1) & mask) {
+    for (std::size_t i = home_slot(k);; i = (i + 1) & mask) {
       const Slot& s = slots_[i];
       if (s.head == kNone) return kNone;
       if (s.key == k) return s.head;
@@ -307,7 +309,7 @@ class VoxelHash {
       rehash(slots_.size() * 2);
     }
     const std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(k) & mask;; i = (i + 1) & mask) {
+    for (std::size_t i = home_slot(k);; i = (i + 1) & mask) {
       Slot& s = slots_[i];
       if (s.head == kNone) {
         s.key = k;
@@ -321,11 +323,13 @@ class VoxelHash {
   }
   void rehash(std::size_t capacity) {
     std::vector<Slot> old = std::move(slots_);
+    shift_ = 64;
+    for (std::size_t c = capacity; c > 1; c >>= 1) --shift_;
     slots_.assign(capacity, Slot{});
     const std::size_t mask = capacity - 1;
     for (const Slot& s : old) {
       if (s.head == kNone) continue;
-      std::size_t i = hash(s.key) & mask;
+      std::size_t i = home_slot(s.key);
       while (slots_[i].head != kNone) i = (i + 1) & mask;
       slots_[i] = s;
     }
@@ -372,7 +376,7 @@ class VoxelHash {
   // the cell's only block.
   void unlink(PointId id, const Key& key) {
     const std::size_t mask = slots_.size() - 1;
-    std::size_t i = hash(key) & mask;
+    std::size_t i = home_slot(key);
     while (!(slots_[i].key == key) || slots_[i].head == kNone) i = (i + 1) & mask;
     Slot& slot = slots_[i];
     const Loc at = loc_[id];
@@ -466,6 +470,7 @@ class VoxelHash {
   S cell_ = S(1);
   S inv_cell_ = S(1);
   std::vector<Slot> slots_;
+  unsigned shift_ = 60;
   std::vector<Block> blocks_;
   std::vector<std::uint32_t> free_blocks_;
   std::vector<Loc> loc_;
