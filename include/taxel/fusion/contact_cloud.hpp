@@ -102,26 +102,26 @@ class ContactCloud {
     if constexpr (F::kMerges) {
       if (const auto hit = index_.nearest_within(contact.position, config_.association_radius)) {
         const index::PointId id = hit->id;
-        State fused = states_[id];
-        if (policy_.fuse(fused, contact, meta_[id].observations)) {
+        Point& point = points_[id];
+        State fused = point.state;
+        if (policy_.fuse(fused, contact, point.meta.observations)) {
           const Vec3<Scalar> mean = policy_.mean(fused);
           if (!all_finite(mean) || !all_finite(policy_.covariance(fused))) {
             // Only reachable with extreme magnitudes (overflow); keep the model intact.
             return {InsertStatus::rejected, 0, ContactDefect::overflow};
           }
-          states_[id] = fused;
-          ++meta_[id].observations;
-          meta_[id].last_time = contact.time;
+          point.state = fused;
+          ++point.meta.observations;
+          point.meta.last_time = contact.time;
           index_.move(id, mean);
           return {InsertStatus::fused, id, ContactDefect::ok};
         }
       }
     }
-    TAXEL_ASSERT(states_.size() < std::numeric_limits<index::PointId>::max(),
+    TAXEL_ASSERT(points_.size() < std::numeric_limits<index::PointId>::max(),
                  "ContactCloud: more than 2^32 - 1 points");
-    const auto id = static_cast<index::PointId>(states_.size());
-    states_.push_back(policy_.init(contact));
-    meta_.push_back({1, contact.time});
+    const auto id = static_cast<index::PointId>(points_.size());
+    points_.push_back({policy_.init(contact), {1, contact.time}});
     index_.insert(id, contact.position);
     return {InsertStatus::added, id, ContactDefect::ok};
   }
@@ -146,33 +146,33 @@ class ContactCloud {
   }
 
   /// Number of fused points.
-  [[nodiscard]] std::size_t size() const noexcept { return states_.size(); }
+  [[nodiscard]] std::size_t size() const noexcept { return points_.size(); }
   /// True when no point exists.
-  [[nodiscard]] bool empty() const noexcept { return states_.empty(); }
+  [[nodiscard]] bool empty() const noexcept { return points_.empty(); }
   /// Mean of point `id` [m].
   [[nodiscard]] Vec3<Scalar> mean(index::PointId id) const {
     TAXEL_ASSERT(id < size(), "ContactCloud::mean: id out of range");
-    return policy_.mean(states_[id]);
+    return policy_.mean(points_[id].state);
   }
   /// Covariance of point `id` [m^2].
   [[nodiscard]] Mat3<Scalar> covariance(index::PointId id) const {
     TAXEL_ASSERT(id < size(), "ContactCloud::covariance: id out of range");
-    return policy_.covariance(states_[id]);
+    return policy_.covariance(points_[id].state);
   }
   /// Number of contacts fused into point `id` (1 for a new point).
   [[nodiscard]] std::uint32_t observations(index::PointId id) const {
     TAXEL_ASSERT(id < size(), "ContactCloud::observations: id out of range");
-    return meta_[id].observations;
+    return points_[id].meta.observations;
   }
   /// Time of the last contact fused into point `id` [s].
   [[nodiscard]] double last_time(index::PointId id) const {
     TAXEL_ASSERT(id < size(), "ContactCloud::last_time: id out of range");
-    return meta_[id].last_time;
+    return points_[id].meta.last_time;
   }
   /// The policy state of point `id`.
   [[nodiscard]] const State& state(index::PointId id) const {
     TAXEL_ASSERT(id < size(), "ContactCloud::state: id out of range");
-    return states_[id];
+    return points_[id].state;
   }
   /// The spatial index over the point means (for k-NN and radius queries).
   [[nodiscard]] const I& index() const noexcept { return index_; }
@@ -189,10 +189,10 @@ class ContactCloud {
     trace.reserve(size());
     time.reserve(size());
     for (std::size_t i = 0; i < size(); ++i) {
-      out.points.push_back(policy_.mean(states_[i]));
-      obs.push_back(static_cast<Scalar>(meta_[i].observations));
-      trace.push_back(policy_.covariance(states_[i]).trace());
-      time.push_back(static_cast<Scalar>(meta_[i].last_time));
+      out.points.push_back(policy_.mean(points_[i].state));
+      obs.push_back(static_cast<Scalar>(points_[i].meta.observations));
+      trace.push_back(policy_.covariance(points_[i].state).trace());
+      time.push_back(static_cast<Scalar>(points_[i].meta.last_time));
     }
     out.fields.push_back({"observations", std::move(obs)});
     out.fields.push_back({"covariance_trace", std::move(trace)});
@@ -202,20 +202,17 @@ class ContactCloud {
 
   /// Removes every point.
   void clear() {
-    states_.clear();
-    meta_.clear();
+    points_.clear();
     index_.clear();
   }
   /// Prepares for `n` points without reallocation.
   void reserve(std::size_t n) {
-    states_.reserve(n);
-    meta_.reserve(n);
+    points_.reserve(n);
     index_.reserve(n);
   }
   /// Heap bytes held by the points and the index.
   [[nodiscard]] std::size_t memory_bytes() const noexcept {
-    return states_.capacity() * sizeof(State) + meta_.capacity() * sizeof(Meta) +
-           index_.memory_bytes();
+    return points_.capacity() * sizeof(Point) + index_.memory_bytes();
   }
 
  private:
@@ -248,8 +245,12 @@ class ContactCloud {
   Config config_;
   F policy_;
   I index_;
-  std::vector<State> states_;
-  std::vector<Meta> meta_;
+  // A point's state and bookkeeping side by side: a fusion touches one record.
+  struct Point {
+    State state;
+    Meta meta;
+  };
+  std::vector<Point> points_;
 };
 
 }  // namespace taxel::fusion
