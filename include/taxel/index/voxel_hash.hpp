@@ -65,7 +65,6 @@ class VoxelHash {
     cell_ = S(2) * radius * (S(1) + kMargin);
     inv_cell_ = S(1) / cell_;
     slots_.assign(16, Slot{});
-    shift_ = 60;
   }
 
   /// Side of a cell [m].
@@ -470,7 +469,7 @@ class VoxelHash {
   S cell_ = S(1);
   S inv_cell_ = S(1);
   std::vector<Slot> slots_;
-  unsigned shift_ = 60;
+  unsigned shift_ = 60;  // 64 - log2(slots_.size())
   std::vector<Block> blocks_;
   std::vector<std::uint32_t> free_blocks_;
   std::vector<Loc> loc_;
