@@ -128,7 +128,7 @@ template <class Shape>
 void pad_study(const char* name, const Shape& shape, bool quick, sim::ContactMode mode,
                bool print_header) {
   sim::ExplorationConfig cfg;
-  cfg.mode = mode;
+  cfg.contacts.mode = mode;
   cfg.seed = 11;
   const int scale = quick ? 1 : 4;
   std::vector<Contact<double>> contacts;

@@ -184,7 +184,7 @@ int main(int argc, char** argv) {
     } else if (a == "--contacts") {
       o.contacts = args.number<std::size_t>(0, std::size_t{1} << 26);
     } else if (a == "--per-pad") {
-      o.config.mode = ts::ContactMode::per_pad;
+      o.config.contacts.mode = ts::ContactMode::per_pad;
     } else if (a == "--slides") {
       o.slide.slides = args.number<int>(1, 10000);
     } else if (a == "--frames") {

@@ -478,9 +478,29 @@ TEST_CASE("Frames to contacts and images", "[drivers][convert]") {
   const std::vector<dsa::MatrixInfo> ms{m};
   const std::vector<Eigen::Isometry3d> poses{pose};
   CHECK(td::frame_contacts(f, ms, poses, contacts) == 84);
+  // The depth of 1000 counts less the censoring correction of the default calibration
+  // (0.3 mm noise, threshold 8): sigma * phi(a) / (1 - Phi(a)), a = (7.5 - 1000) / 4095 * 3 mm
+  // / 0.3 mm.
+  const double dq = 3e-3 / 4095, a = (7.5 * dq - 1000 * dq) / 0.3e-3;
+  const double correction = 0.3e-3 * std::exp(-0.5 * a * a) / std::sqrt(2 * M_PI) /
+                            (0.5 * std::erfc(a / std::sqrt(2.0)));
   for (const auto& c : contacts) {
-    CHECK(c.position.z() == Approx(-1000.0 / 4095 * 3e-3));
+    CHECK(c.position.z() == Approx(-1000.0 * dq + correction).epsilon(1e-9));
     CHECK(c.time == 0.5);
+  }
+  SECTION("the drivers' contacts are the simulator's on the same readings") {
+    taxel::sim::PadReading r;
+    r.counts = f.matrices[0];
+    r.believed_pose = pose;
+    std::vector<taxel::Contact<double>> sim_contacts;
+    taxel::sim::pad_contacts(r, td::sensor_model(m), taxel::sim::ContactMode::per_tactel, 0.5,
+                             sim_contacts);
+    REQUIRE(sim_contacts.size() == contacts.size());
+    for (std::size_t i = 0; i < contacts.size(); ++i) {
+      CHECK(sim_contacts[i].position == contacts[i].position);
+      CHECK(sim_contacts[i].covariance == contacts[i].covariance);
+      CHECK(*sim_contacts[i].normal == *contacts[i].normal);
+    }
   }
   taxel::fusion::ContactCloud<taxel::fusion::Kalman<double>> cloud({.association_radius = 5e-3});
   CHECK(cloud.insert(std::span<const taxel::Contact<double>>(contacts)).rejected == 0);

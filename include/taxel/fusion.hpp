@@ -7,3 +7,4 @@
 #include "taxel/fusion/contact_cloud.hpp"
 #include "taxel/fusion/kalman.hpp"
 #include "taxel/fusion/raw.hpp"
+#include "taxel/fusion/surfel.hpp"

@@ -9,4 +9,5 @@
 #include "taxel/io.hpp"
 #include "taxel/learn.hpp"
 #include "taxel/registration.hpp"
+#include "taxel/sensor.hpp"
 #include "taxel/sim.hpp"

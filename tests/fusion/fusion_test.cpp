@@ -54,7 +54,10 @@ bool symmetric_positive_definite(const M& m) {
 
 }  // namespace
 
-TEMPLATE_TEST_CASE("Raw, Average and Kalman satisfy FusionPolicy", "[fusion]", float, double) {
+TEMPLATE_TEST_CASE("Raw, Average, Kalman and Surfel satisfy FusionPolicy", "[fusion]", float,
+                   double) {
+  STATIC_REQUIRE(tf::FusionPolicy<tf::Surfel<TestType>>);
+  STATIC_REQUIRE(tf::Surfel<TestType>::kMerges);
   STATIC_REQUIRE(tf::FusionPolicy<tf::Raw<TestType>>);
   STATIC_REQUIRE(tf::FusionPolicy<tf::Average<TestType>>);
   STATIC_REQUIRE(tf::FusionPolicy<tf::Kalman<TestType>>);
@@ -344,12 +347,20 @@ TEST_CASE("ContactCloud rejects invalid contacts and stays unchanged", "[fusion]
 
 TEST_CASE("ContactCloud rejects bad configuration naming the field", "[fusion]") {
   using Catch::Matchers::Contains;
+  using KalmanCloud = tf::ContactCloud<tf::Kalman<double>>;
   CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = 0}), Contains("association_radius"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = std::nan("")}),
                     Contains("association_radius"));
-  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.process_noise = -1}}),
+  CHECK_THROWS_WITH(KalmanCloud({.fusion = {.process_noise = -1}}), Contains("process_noise"));
+  CHECK_THROWS_WITH(KalmanCloud({.fusion = {.gate_chi2 = 0.0}}), Contains("gate_chi2"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.kalman = {.process_noise = -1}}}),
                     Contains("process_noise"));
-  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.gate_chi2 = 0.0}}), Contains("gate_chi2"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.max_normal_angle = 2.0}}),
+                    Contains("max_normal_angle"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.normal_sigma = 0.0}}),
+                    Contains("normal_sigma"));
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.curvature_prior = -1.0}}),
+                    Contains("curvature_prior"));
   CHECK_THROWS_WITH(tf::ContactCloud<tf::Average<double>>(
                         {.fusion = {.mode = tf::Average<double>::Mode::exponential, .alpha = 1.5}}),
                     Contains("alpha"));
@@ -405,4 +416,135 @@ TEST_CASE("fused clouds are compact and closer to the surface than raw contacts"
               << " pts rms " << k_err.rms);
   CHECK(kalman.size() * 10 < raw.size());
   CHECK(k_err.rms < raw_err.rms);
+}
+
+namespace {
+// A contact on a sphere of radius R (centre at the origin) near the unit direction `at`,
+// within `spread` of it, with its exact outward normal (tilted by up to `normal_noise` rad)
+// and a pad covariance (sn along the normal, st across) whose tight axis follows that normal.
+taxel::Contact<double> sphere_contact(std::mt19937& rng, double R, const taxel::Vec3d& at,
+                                      double spread, double normal_noise, double sn, double st) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  taxel::Vec3d d;
+  do {
+    d = spread * taxel::Vec3d(u(rng), u(rng), u(rng));
+  } while (d.norm() > spread);
+  const taxel::Vec3d p = (R * at + d).normalized() * R;
+  const taxel::Vec3d n =
+      (p.normalized() + normal_noise * taxel::Vec3d(g(rng), g(rng), g(rng)) / std::sqrt(3.0))
+          .normalized();
+  taxel::Contact<double> c = contact_at<double>(p, taxel::pad_covariance(n, sn, st));
+  c.normal = n;
+  return c;
+}
+}  // namespace
+
+TEST_CASE("Surfel lands on a curved surface where Kalman lands outside and Average inside",
+          "[fusion]") {
+  // 200 points on spheres of 40 and 15 mm, each fed 200 exact contacts from a 4 mm patch with
+  // normals noisy by 0.1 rad: the closed forms say Average sits E[u'Hu]/2 inside (chord sag,
+  // 0.080 / 0.213 mm here) and Kalman about (1 - 2 sn^2/st^2) of that outside.
+  for (const double R : {0.04, 0.015}) {
+    std::mt19937 rng(7);
+    const tf::Surfel<double> surfel;
+    const tf::Kalman<double> kalman;
+    const tf::Average<double> average;
+    double bias_s = 0, bias_k = 0, bias_a = 0, worst_s = 0;
+    const int points = 200;
+    for (int t = 0; t < points; ++t) {
+      const taxel::Vec3d at = random_normal(rng, M_PI);
+      auto c = sphere_contact(rng, R, at, 4e-3, 0.1, 0.3e-3, 1e-3);
+      auto s = surfel.init(c);
+      auto k = kalman.init(c);
+      auto a = average.init(c);
+      for (std::uint32_t i = 1; i < 200; ++i) {
+        c = sphere_contact(rng, R, at, 4e-3, 0.1, 0.3e-3, 1e-3);
+        REQUIRE(surfel.fuse(s, c, i));
+        kalman.fuse(k, c, i);
+        average.fuse(a, c, i);
+      }
+      const double e = surfel.mean(s).norm() - R;
+      bias_s += e / points;
+      worst_s = std::max(worst_s, std::abs(e));
+      bias_k += (kalman.mean(k).norm() - R) / points;
+      bias_a += (average.mean(a).norm() - R) / points;
+    }
+    const double sag = 0.5 * 2 * (16e-6 / 5) / R;  // E[u'Hu]/2 over a uniform 4 mm ball
+    CAPTURE(R, bias_s, bias_k, bias_a, worst_s);
+    CHECK(bias_a == Approx(-sag).epsilon(0.05));
+    CHECK(bias_k > 0.7 * sag);
+    CHECK(std::abs(bias_s) < 0.05 * sag);
+    CHECK(worst_s < 0.25 * sag);
+  }
+}
+
+TEST_CASE("Surfel equals Kalman on a plane with exact normals", "[fusion]") {
+  // All contacts share the plane's normal: no turn, no curvature; with one covariance for all
+  // the Kalman mean is the average, and so is the Surfel's point.
+  std::mt19937 rng(9);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const taxel::Vec3d n = random_normal(rng, 1.0);
+  const taxel::Vec3d a = n.unitOrthogonal(), b = n.cross(a);
+  const tf::Surfel<double> surfel;
+  const tf::Kalman<double> kalman;
+  const taxel::Mat3d R = taxel::pad_covariance(n, 0.3e-3, 1e-3);
+  const auto make = [&] {
+    auto c = contact_at<double>(taxel::Vec3d(0.01, 0.02, 0.03) + 1e-3 * g(rng) * a +
+                                    1e-3 * g(rng) * b + 0.3e-3 * g(rng) * n,
+                                R);
+    c.normal = n;
+    return c;
+  };
+  auto c = make();
+  auto s = surfel.init(c);
+  auto k = kalman.init(c);
+  for (std::uint32_t i = 1; i < 500; ++i) {
+    c = make();
+    surfel.fuse(s, c, i);
+    kalman.fuse(k, c, i);
+  }
+  double h[3];
+  surfel.fit_curvature(s, h);
+  CHECK(std::abs(h[0]) + std::abs(h[1]) + std::abs(h[2]) < 1e-9);
+  CHECK((surfel.mean(s) - kalman.mean(k)).norm() < 1e-12);
+  CHECK((surfel.covariance(s) - kalman.covariance(k)).norm() < 1e-18);
+  SECTION("contacts without a normal: exactly Kalman") {
+    auto c0 = make();
+    c0.normal.reset();
+    auto s0 = surfel.init(c0);
+    auto k0 = kalman.init(c0);
+    for (std::uint32_t i = 1; i < 50; ++i) {
+      auto ci = make();
+      ci.normal.reset();
+      surfel.fuse(s0, ci, i);
+      kalman.fuse(k0, ci, i);
+    }
+    CHECK(surfel.mean(s0) == kalman.mean(k0));
+  }
+}
+
+TEST_CASE("Surfel fits the curvature of a cylinder patch", "[fusion]") {
+  // Contacts on a cylinder of radius 30 mm (axis z) around (R, 0, 0), exact normals: the fitted
+  // curvature has 1/R across the axis and 0 along it.
+  const double R = 0.03;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-3e-3, 3e-3);
+  const tf::Surfel<double> surfel;
+  const auto make = [&] {
+    const double phi = u(rng) / R, z = u(rng);
+    const taxel::Vec3d n(std::cos(phi), std::sin(phi), 0);
+    auto c = contact_at<double>(R * n + taxel::Vec3d(0, 0, z), taxel::pad_covariance(n, 3e-4, 1e-3));
+    c.normal = n;
+    return c;
+  };
+  auto s = surfel.init(make());
+  for (std::uint32_t i = 1; i < 400; ++i) surfel.fuse(s, make(), i);
+  double h[3];
+  surfel.fit_curvature(s, h);
+  // In the point's own tangent frame (t1, n0 x t1): H = (1/R) e e' with e the tangent across
+  // the axis, so trace 1/R and determinant 0.
+  CHECK(h[0] + h[2] == Approx(1 / R).epsilon(0.03));
+  CHECK(std::abs(h[0] * h[2] - h[1] * h[1]) < 0.05 / (R * R));
+  CHECK(std::abs(surfel.mean(s).head<2>().norm() - R) < 5e-6);
 }

@@ -53,10 +53,13 @@ TEST_CASE("pad readings follow the indentation, contacts lie on the pressed surf
     CHECK(c.normal->isApprox(Vec3d::UnitZ()));
     CHECK(c.time == 0.5);
     CHECK(taxel::check_contact(c) == taxel::ContactDefect::ok);
-    // In-plane variance: quantisation over one tactel; along the normal: depth quantisation.
+    // In-plane variance: quantisation over one tactel; along the normal: depth quantisation
+    // and the normal's own uncertainty over the tactel's footprint (a few per cent here).
     const Eigen::SelfAdjointEigenSolver<taxel::Mat3d> eig(c.covariance);
     CHECK(eig.eigenvalues()(2) == Approx(std::pow(3.4e-3, 2) / 12).epsilon(1e-9));
-    CHECK(c.covariance(2, 2) == Approx(quantum * quantum / 12).epsilon(1e-6));
+    CHECK(c.covariance(2, 2) >= quantum * quantum / 12);
+    // Corner tactels fit their normal to four depths: var g = 2 * vd / pitch^2 per axis.
+    CHECK(c.covariance(2, 2) <= (1.0 + 1.0 / 6.0) * quantum * quantum / 12 * (1 + 1e-9));
   }
   // The tactel grid: x spans 5 pitches, y spans 13.
   double xmin = 1, xmax = -1, ymin = 1, ymax = -1;
@@ -127,7 +130,7 @@ TEST_CASE("pad noise: the scatter along the normal matches the stated covariance
   const ts::Box box;
   ts::SensorModel m;  // default noise: 0.3 mm depth, 0.2 mm position, 0.02 rad tilt
   std::mt19937_64 rng(3);
-  double sum_ratio = 0.0;
+  double sum_ratio = 0.0, sum_angle2 = 0.0;
   std::size_t count = 0;
   for (int frame = 0; frame < 3000; ++frame) {
     const ts::PadReading r = ts::read_pad(box, m, on_box_top(1.5e-3), rng);
@@ -139,11 +142,17 @@ TEST_CASE("pad noise: the scatter along the normal matches the stated covariance
       // Variance the contact claims along the true normal (+z), against the squared error.
       sum_ratio += e * e / Vec3d::UnitZ().dot(c.covariance * Vec3d::UnitZ());
       ++count;
-      CHECK(n.z() > 0.99);
+      // Normals from the depth map: slope noise 0.3 mm over the 3x3 fit (about 0.04 rad per
+      // axis inside, 0.09 at the corners) plus the pose's 0.02 rad tilt.
+      const double angle = std::acos(std::min(1.0, n.z()));
+      sum_angle2 += angle * angle;
+      CHECK(angle < 0.45);
     }
   }
   REQUIRE(count > 100000);
   CHECK(sum_ratio / double(count) == Approx(1.0).margin(0.06));
+  CHECK(std::sqrt(sum_angle2 / double(count)) < 0.09);
+  CHECK(std::sqrt(sum_angle2 / double(count)) > 0.03);
 }
 
 TEST_CASE("explorations: deterministic, timed, on the surface, at the object's pose",
@@ -191,7 +200,7 @@ TEST_CASE("explorations: deterministic, timed, on the surface, at the object's p
   }
   SECTION("per-pad contacts: at most one per pad and frame") {
     ts::ExplorationConfig per_pad = cfg;
-    per_pad.mode = ts::ContactMode::per_pad;
+    per_pad.contacts.mode = ts::ContactMode::per_pad;
     const auto g = ts::explore_grasps(cyl, per_pad, {.grasps = 4});
     for (const auto& f : g.frames) CHECK(f.contacts.size() <= f.pads.size());
     CHECK(g.contact_count() > 0);

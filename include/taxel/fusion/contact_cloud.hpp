@@ -17,6 +17,7 @@
 #include "taxel/core/point_cloud.hpp"
 #include "taxel/fusion/concepts.hpp"
 #include "taxel/fusion/kalman.hpp"
+#include "taxel/fusion/surfel.hpp"
 #include "taxel/index/concepts.hpp"
 #include "taxel/index/voxel_hash.hpp"
 
@@ -71,7 +72,7 @@ struct BatchResult {
 /// `memory_bytes`). `insert` of a contact that fuses allocates nothing (with VoxelHash, when
 /// the point stays in its cell, which is the common case; a cell change may grow a block pool).
 /// Not thread-safe for writes.
-template <FusionPolicy F = Kalman<double>,
+template <FusionPolicy F = Surfel<double>,
           index::IncrementalIndex I = index::VoxelHash<typename F::Scalar>>
 requires std::same_as<typename F::Scalar, typename I::Scalar>
 class ContactCloud {

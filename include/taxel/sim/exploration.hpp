@@ -27,7 +27,7 @@ namespace taxel::sim {
 /// Settings shared by every exploration.
 struct ExplorationConfig {
   SensorModel sensor;                          ///< the pads (all pads of a hand are alike)
-  ContactMode mode = ContactMode::per_tactel;  ///< contacts per active tactel or per pad
+  sensor::ContactOptions contacts{};  ///< how readings become contacts (per tactel or per pad)
   double frame_rate = 1000.0;                  ///< frames per second [Hz], > 0
   double indentation = 1.0e-3;                 ///< how far a pad presses into the object [m], > 0
   Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  ///< shape frame -> world
@@ -36,6 +36,7 @@ struct ExplorationConfig {
   /// Throws std::invalid_argument naming the first parameter out of range.
   void validate() const {
     sensor.validate();
+    contacts.validate();
     if (!(frame_rate > 0) || !std::isfinite(frame_rate))
       throw std::invalid_argument("ExplorationConfig: frame_rate must be finite and > 0");
     if (!(indentation > 0) || !std::isfinite(indentation))
@@ -138,12 +139,12 @@ double deepest(const Sh& shape, const PadGeometry& g, const Eigen::Isometry3d& p
 }
 
 template <Shape Sh>
-void add_frame(Exploration<Sh>& ex, const ExplorationConfig& cfg, double time,
+void add_frame(Exploration<Sh>& ex, sensor::ContactExtractor& extractor, double time,
                std::vector<PadReading>&& pads) {
   ExplorationFrame f;
   f.time = time;
   f.pads = std::move(pads);
-  for (const auto& p : f.pads) pad_contacts(p, cfg.sensor, cfg.mode, time, f.contacts);
+  for (const auto& p : f.pads) extractor.extract(p.counts, p.believed_pose, time, f.contacts);
   ex.frames.push_back(std::move(f));
 }
 
@@ -162,6 +163,7 @@ Exploration<Sh> explore_sliding(const Sh& shape, const ExplorationConfig& cfg,
   }
   Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
   const Posed<Sh>& world = ex.truth;
+  sensor::ContactExtractor extractor(cfg.sensor, cfg.contacts);
   std::mt19937_64 rng(cfg.seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   const double step = p.speed / cfg.frame_rate;
@@ -177,7 +179,7 @@ Exploration<Sh> explore_sliding(const Sh& shape, const ExplorationConfig& cfg,
       const Eigen::Isometry3d pose = detail::pad_pose(-n, heading, at - cfg.indentation * n);
       std::vector<PadReading> pads;
       pads.push_back(read_pad(world, cfg.sensor, pose, rng, 0));
-      detail::add_frame(ex, cfg, double(tick) / cfg.frame_rate, std::move(pads));
+      detail::add_frame(ex, extractor, double(tick) / cfg.frame_rate, std::move(pads));
       heading = Eigen::AngleAxisd(p.heading_sigma * gauss(rng), n) * heading;
       at = world.closest_point(at + step * heading);
       const Vec3d n_new = world.normal(at);
@@ -204,6 +206,7 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
   }
   Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
   const Posed<Sh>& world = ex.truth;
+  sensor::ContactExtractor extractor(cfg.sensor, cfg.contacts);
   // Centre and reach of the object, from surface samples.
   const PointCloud<double> samples = sample_surface(world, 2000, cfg.seed ^ 0x5eedULL);
   Vec3d centre = Vec3d::Zero();
@@ -270,7 +273,7 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
             detail::pad_pose(pad.inward, axis, pad.origin + s * pad.inward);
         readings.push_back(read_pad(world, cfg.sensor, pose, rng, static_cast<int>(i)));
       }
-      detail::add_frame(ex, cfg, double(tick) / cfg.frame_rate, std::move(readings));
+      detail::add_frame(ex, extractor, double(tick) / cfg.frame_rate, std::move(readings));
     }
   }
   return ex;
@@ -288,6 +291,7 @@ Exploration<Sh> explore_palpation(const Sh& shape, const ExplorationConfig& cfg,
   }
   Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
   const Posed<Sh>& world = ex.truth;
+  sensor::ContactExtractor extractor(cfg.sensor, cfg.contacts);
   std::mt19937_64 rng(cfg.seed);
   const double step = p.press_speed / cfg.frame_rate;
   const int pressing = static_cast<int>(std::ceil(cfg.indentation / step)) + 2;
@@ -300,7 +304,7 @@ Exploration<Sh> explore_palpation(const Sh& shape, const ExplorationConfig& cfg,
       const double s = std::min(double(f - 2) * step, cfg.indentation);
       std::vector<PadReading> readings;
       readings.push_back(read_pad(world, cfg.sensor, detail::pad_pose(-n, y, at - s * n), rng, 0));
-      detail::add_frame(ex, cfg, double(tick) / cfg.frame_rate, std::move(readings));
+      detail::add_frame(ex, extractor, double(tick) / cfg.frame_rate, std::move(readings));
     }
   }
   return ex;

@@ -106,24 +106,28 @@ std::vector<Contact<double>> sliding_exploration(const Sh& shape, std::size_t co
 
 /// Distances of points to a shape's surface [m].
 struct SurfaceError {
-  double mean = 0;  ///< mean |signed distance|
+  double signed_mean = 0;  ///< mean signed distance (outside positive): the bias
+  double mean = 0;         ///< mean |signed distance|
   double rms = 0;   ///< root mean square signed distance
   double max = 0;   ///< largest |signed distance|
 };
 
-/// Mean, RMS and max distance of `points` to the surface of `shape`; zeros for no points.
+/// Signed mean, mean, RMS and max distance of `points` to the surface of `shape`; zeros for no points.
 template <Shape Sh, class Points>
 SurfaceError surface_error(const Sh& shape, const Points& points) {
   SurfaceError e;
   std::size_t n = 0;
   for (const auto& p : points) {
-    const double d = std::abs(shape.signed_distance(p.template cast<double>()));
+    const double sd = shape.signed_distance(p.template cast<double>());
+    const double d = std::abs(sd);
+    e.signed_mean += sd;
     e.mean += d;
     e.rms += d * d;
     e.max = std::max(e.max, d);
     ++n;
   }
   if (n > 0) {
+    e.signed_mean /= double(n);
     e.mean /= double(n);
     e.rms = std::sqrt(e.rms / double(n));
   }

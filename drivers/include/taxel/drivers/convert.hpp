@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // From controller frames to what the rest of taxel eats: contacts with the pad's anisotropic
 // covariance (for fusion::ContactCloud) and pressure images (for the image pipeline). The
-// reading-to-contact model is the simulator's (sim/sensor.hpp: pad_contacts), so simulated and
-// real streams go through the same arithmetic.
+// reading-to-contact model is sensor/contacts.hpp's, the one the simulator uses too, so simulated
+// and real streams go through the same arithmetic.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -16,6 +16,7 @@
 #include "taxel/core/contact.hpp"
 #include "taxel/drivers/dsacon_device.hpp"
 #include "taxel/image/types.hpp"
+#include "taxel/sensor/contacts.hpp"
 #include "taxel/sim/sensor.hpp"
 
 namespace taxel::drivers {
@@ -61,7 +62,8 @@ inline std::size_t frame_contacts(const TactileFrame& frame,
                                   std::span<const Eigen::Isometry3d> pad_poses,
                                   std::vector<Contact<double>>& out,
                                   sim::ContactMode mode = sim::ContactMode::per_tactel,
-                                  const PadCalibration& cal = {}) {
+                                  const PadCalibration& cal = {},
+                                  const sensor::ContactOptions& options = {}) {
   if (frame.matrices.size() != matrices.size() || pad_poses.size() != matrices.size()) {
     throw std::invalid_argument("frame_contacts: " + std::to_string(frame.matrices.size()) +
                                 " matrices in the frame, " + std::to_string(matrices.size()) +
@@ -69,13 +71,11 @@ inline std::size_t frame_contacts(const TactileFrame& frame,
   }
   std::size_t n = 0;
   for (std::size_t i = 0; i < matrices.size(); ++i) {
-    const sim::SensorModel model = sensor_model(matrices[i], cal);
-    sim::PadReading r;
-    r.pad = static_cast<int>(i);
-    r.counts = (frame.matrices[i] < std::uint16_t(cal.threshold))
-                   .select(std::uint16_t{0}, frame.matrices[i]);
-    r.true_pose = r.believed_pose = pad_poses[i];
-    n += sim::pad_contacts(r, model, mode, 1e-3 * double(frame.device_time_ms), out);
+    sensor::ContactOptions o = options;
+    o.mode = mode;
+    sensor::ContactExtractor extractor(sensor_model(matrices[i], cal), o);
+    n += extractor.extract(frame.matrices[i], pad_poses[i], 1e-3 * double(frame.device_time_ms),
+                           out);
   }
   return n;
 }

@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: MIT
+// Surfel: a Kalman point that knows it sits on a curved surface.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "taxel/core/contact.hpp"
+#include "taxel/fusion/kalman.hpp"
+
+namespace taxel::fusion {
+
+/// Fuses contacts into a surface point, one contact at a time, like `Kalman`, but without the
+/// bias a static 3-D state has on a curved surface.
+///
+/// Why. A fused point gathers contacts from a patch as wide as the association gate. On a
+/// surface of curvature H, a contact at a sideways offset u from the point lies u'Hu/2 below
+/// the point's tangent plane (the sag) and its normal is turned by about Hu. Averaging
+/// positions lands the point inside the surface by E[u'Hu]/2 (chord sag). A Kalman filter
+/// fed covariances whose tight axis follows each contact's own normal lands outside by about
+/// (1 - 2 s_n^2/s_t^2) E[u'Hu]/2: each tight plane is the tangent plane at its own contact,
+/// and tangent planes of a convex patch meet outside it.
+///
+/// What. The point keeps a tangent frame (normal n0 and origin from its first contact with a
+/// normal) and, for every contact whose normal lies within `max_normal_angle` of the point's
+/// mean normal:
+///  - the contact's covariance is turned onto the point's mean normal (Rodrigues rotation
+///    taking the contact normal to it), so all tight planes are parallel and the Kalman mean
+///    is an information-weighted average in that frame, whose only bias is the sag;
+///  - its sideways offset u (in the frame) and its normal's slope s (sideways part over
+///    normal part, which is H u + const on a quadric) are accumulated, 12 sums in all;
+///  - the curvature H is the symmetric part of the least-squares fit of s on u, with a ridge
+///    prior H ~ N(0, curvature_prior^2) against normal noise `normal_sigma`, so that few or
+///    collinear contacts give H near 0;
+///  - the mean is the Kalman mean moved outward along n0 by the sag tr(H M) / 2, M the
+///    second moment of the accumulated offsets about the Kalman mean.
+/// Contacts without a normal, or turned further than `max_normal_angle` (across an edge),
+/// update the Kalman state unchanged and do not enter the sums. On a plane with exact normals
+/// (all equal) the rotation is the identity and H = 0: the result is exactly `Kalman`'s.
+/// The offsets are measured positions: their own noise is not removed from M (the contacts
+/// a point gathers are those whose noisy positions fall near it, a Berkson error model, so
+/// an errors-in-variables correction would overcorrect). State: 264 bytes (double).
+/// No allocation.
+template <Scalar S>
+struct Surfel {
+  using Scalar = S;
+  /// Configuration; defaults suit tactile pads of a few millimetres pitch.
+  struct Config {
+    typename Kalman<S>::Config kalman{};  ///< process noise, gate and P0 of the filter
+    S max_normal_angle = S(1.2);  ///< contacts turned further [rad] are not curvature data, in (0, pi/2)
+    S normal_sigma = S(0.05);       ///< noise of a contact normal [rad], > 0
+    S curvature_prior = S(100);     ///< prior standard deviation of the curvature [1/m], > 0
+  };
+  /// A fused point: the Kalman state, its tangent frame and the curvature sums.
+  struct State {
+    typename Kalman<S>::State kalman;
+    Vec3<S> origin;       ///< frame origin [m]: the first contact with a normal
+    Vec3<S> n0;           ///< frame normal (zero until a contact with a normal arrives)
+    Vec3<S> t1;           ///< first tangent of the frame; the second is n0 x t1
+    Vec3<S> normal_sum;   ///< sum of the accepted contact normals
+    S count;              ///< contacts in the sums
+    S weight;             ///< sum of their weights w (information along the normal) [1/m^2]
+    S sz;                 ///< w-weighted sum of the heights z along n0 [m]
+    S su[2], ss[2];       ///< w-weighted sums of u [m] and s [-]
+    S suu[3];             ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
+    S ssu[4];             ///< w-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
+  };
+  static constexpr bool kMerges = true;
+
+  Surfel() = default;
+  /// Throws std::invalid_argument naming the field that is out of range.
+  explicit Surfel(const Config& config) : config_(config), kalman_(config.kalman) {
+    if (!(config.max_normal_angle > S(0)) || !(config.max_normal_angle < S(1.5707963267948966))) {
+      throw std::invalid_argument("Surfel::Config::max_normal_angle must be in (0, pi/2), got " +
+                                  std::to_string(config.max_normal_angle));
+    }
+    if (!(config.normal_sigma > S(0)) || !std::isfinite(config.normal_sigma)) {
+      throw std::invalid_argument("Surfel::Config::normal_sigma must be finite and > 0, got " +
+                                  std::to_string(config.normal_sigma));
+    }
+    if (!(config.curvature_prior > S(0)) || !std::isfinite(config.curvature_prior)) {
+      throw std::invalid_argument("Surfel::Config::curvature_prior must be finite and > 0, got " +
+                                  std::to_string(config.curvature_prior));
+    }
+    cos_max_ = std::cos(config.max_normal_angle);
+  }
+
+  /// A point at the contact; its frame starts here when the contact has a normal.
+  State init(const Contact<S>& c) const {
+    State s{};
+    s.kalman = kalman_.init(c);
+    if (c.normal) start_frame(s, c);
+    return s;
+  }
+
+  /// One update; false (state untouched) when the Kalman gate refuses the contact.
+  bool fuse(State& s, const Contact<S>& c, std::uint32_t n) const {
+    if (!c.normal) return kalman_.fuse(s.kalman, c, n);
+    if (s.count == S(0)) {
+      if (!kalman_.fuse(s.kalman, c, n)) return false;
+      start_frame(s, c);
+      return true;
+    }
+    const Vec3<S>& nc = *c.normal;
+    const Vec3<S> nm = s.normal_sum.normalized();
+    const S cos_c = nc.dot(nm);
+    if (!(cos_c >= cos_max_)) return kalman_.fuse(s.kalman, c, n);
+    // Turn the covariance onto the mean normal: Q = I + [v]x + [v]x^2 / (1 + c), v = nc x nm.
+    const Vec3<S> v = nc.cross(nm);
+    Mat3<S> vx;
+    vx << S(0), -v.z(), v.y(), v.z(), S(0), -v.x(), -v.y(), v.x(), S(0);
+    const Mat3<S> q = Mat3<S>::Identity() + vx + (vx * vx) / (S(1) + cos_c);
+    Contact<S> turned = c;
+    turned.covariance = q * c.covariance * q.transpose();
+    turned.covariance = S(0.5) * (turned.covariance + turned.covariance.transpose()).eval();
+    if (!kalman_.fuse(s.kalman, turned, n)) return false;
+    // Curvature sums in the frame of the first contact.
+    const Vec3<S> t2 = s.n0.cross(s.t1);
+    const Vec3<S> d = c.position - s.origin;
+    const S ux = s.t1.dot(d), uy = t2.dot(d);
+    const S nz = nc.dot(s.n0);
+    if (!(nz > S(0))) return true;
+    const S sx = s.t1.dot(nc) / nz, sy = t2.dot(nc) / nz;
+    // Weighted like the Kalman average along the normal: by the contact's information there.
+    const S w = S(1) / nm.dot(turned.covariance * nm);
+    s.normal_sum += nc;
+    s.count += S(1);
+    add_sums(s, w, ux, uy, s.n0.dot(d), sx, sy);
+    return true;
+  }
+
+  /// The surface point [m]: the point of the quadric fitted to the contacts above their
+  /// weighted centroid in the tangent plane (the Kalman mean until a contact with a normal
+  /// arrives).
+  Vec3<S> mean(const State& s) const noexcept {
+    if (s.count < S(1)) return s.kalman.mean;
+    const S inv = S(1) / s.weight;
+    const S ux = s.su[0] * inv, uy = s.su[1] * inv;
+    S h[3];
+    fit_curvature(s, h);
+    // Height of the quadric z(u) = z0 + g'u - u'Hu/2 at the centroid: the mean height plus the
+    // sag tr(H C_uu) / 2.
+    const S cxx = s.suu[0] * inv - ux * ux, cxy = s.suu[1] * inv - ux * uy;
+    const S cyy = s.suu[2] * inv - uy * uy;
+    const S z = s.sz * inv + S(0.5) * (h[0] * cxx + S(2) * h[1] * cxy + h[2] * cyy);
+    return s.origin + ux * s.t1 + uy * s.n0.cross(s.t1) + z * s.n0;
+  }
+  /// The filter covariance [m^2] (of the Kalman state; the sag term adds no variance).
+  const Mat3<S>& covariance(const State& s) const noexcept { return s.kalman.covariance; }
+
+  /// The fitted curvature (H_xx, H_xy, H_yy) [1/m] in the point's tangent frame; zeros with
+  /// fewer than three contacts in the sums.
+  void fit_curvature(const State& s, S h[3]) const noexcept {
+    h[0] = h[1] = h[2] = S(0);
+    if (s.count < S(3)) return;
+    const S inv = S(1) / s.weight;
+    const S ux = s.su[0] * inv, uy = s.su[1] * inv, sx = s.ss[0] * inv, sy = s.ss[1] * inv;
+    const S lambda = config_.normal_sigma * config_.normal_sigma /
+                     (config_.curvature_prior * config_.curvature_prior) / s.count;
+    const S a = s.suu[0] * inv - ux * ux + lambda, b = s.suu[1] * inv - ux * uy;
+    const S d = s.suu[2] * inv - uy * uy + lambda;
+    const S det = a * d - b * b;
+    if (!(det > S(0))) return;
+    // C_su (C_uu + lambda I)^-1, rows s_x, s_y; its symmetric part.
+    const S cxx = s.ssu[0] * inv - sx * ux, cxy = s.ssu[1] * inv - sx * uy;
+    const S cyx = s.ssu[2] * inv - sy * ux, cyy = s.ssu[3] * inv - sy * uy;
+    const S inv_det = S(1) / det;
+    h[0] = (cxx * d - cxy * b) * inv_det;
+    h[1] = S(0.5) * ((cxy * a - cxx * b) + (cyx * d - cyy * b)) * inv_det;
+    h[2] = (cyy * a - cyx * b) * inv_det;
+  }
+
+ private:
+  static void start_frame(State& s, const Contact<S>& c) {
+    s.origin = c.position;
+    s.n0 = *c.normal;
+    s.t1 = s.n0.unitOrthogonal();
+    s.normal_sum = s.n0;
+    s.count = S(1);
+    add_sums(s, S(1) / s.n0.dot(c.covariance * s.n0), S(0), S(0), S(0), S(0), S(0));
+  }
+  static void add_sums(State& s, S w, S ux, S uy, S z, S sx, S sy) {
+    s.weight += w;
+    s.sz += w * z;
+    s.su[0] += w * ux;
+    s.su[1] += w * uy;
+    s.ss[0] += w * sx;
+    s.ss[1] += w * sy;
+    s.suu[0] += w * ux * ux;
+    s.suu[1] += w * ux * uy;
+    s.suu[2] += w * uy * uy;
+    s.ssu[0] += w * sx * ux;
+    s.ssu[1] += w * sx * uy;
+    s.ssu[2] += w * sy * ux;
+    s.ssu[3] += w * sy * uy;
+  }
+
+  Config config_{};
+  Kalman<S> kalman_{};
+  S cos_max_ = S(0.36235775447667357);  // cos(1.2)
+};
+
+}  // namespace taxel::fusion

@@ -1,0 +1,351 @@
+// SPDX-License-Identifier: MIT
+// Readings to contacts: the one place where a pad's readings and pose become contacts with
+// positions, surface normals and measurement covariances. The simulator, the drivers and the
+// tools all call it, so a recorded sensor and a simulated one go through the same arithmetic.
+//
+// The model, per active tactel (a reading k with threshold <= k < levels - 1):
+//  1. Depth. The reading gives the measured compression m = k * full_scale_depth / (levels - 1).
+//     Readings below the threshold are reported as zero, so a barely touching tactel survives
+//     only when its depth noise is positive: the surviving readings are a truncated sample and
+//     their mean lies above the true depth d by sigma * lambda((t - d) / sigma), with lambda the
+//     inverse Mills ratio phi(a) / (1 - Phi(a)) of the normal distribution and t the threshold
+//     depth (the mean of a truncated normal; Johnson, Kotz and Balakrishnan, Continuous
+//     Univariate Distributions, vol. 1, 2nd ed., 1994, Sec. 10.1). The depth used is the plug-in
+//     correction d = m - sigma * lambda((t - m) / sigma); it vanishes for readings a few sigma
+//     above the threshold and its square is added to the depth variance.
+//  2. Normal. A plane d(x, y) = a + g . (x, y) is fitted by least squares to the corrected
+//     depths of the tactel and its active 8-neighbours; the surface in the pad frame is
+//     z = -d(x, y), so its outward normal is -(g_x, g_y, 1) / |(g_x, g_y, 1)|. Where the active
+//     neighbours span only a row or a column, the slope across it is taken as zero, and where
+//     they span neither, the pad normal (-z) is used; a slope not measured gets the variance
+//     fallback_normal_sigma^2.
+//  3. Covariance. Tight along that normal, wide across it:
+//       across:  s_t^2 = pitch^2 / 12 + sigma_position^2 + |xy|^2 sigma_tilt^2 / 6
+//       along:   s_n^2 = sigma_normal^2 + dq^2 / 12 + c^2 + sigma_position^2
+//                        + |xy|^2 sigma_tilt^2 / 3 + (pitch^2 / 12) (var g_x + var g_y)
+//     (dq the depth of one count, c the censoring correction, |xy| the tactel's lever arm from
+//     the pad origin; the last term is the normal's own uncertainty: a plane tilted by beta
+//     misstates the height by beta * u over a sideways offset u, and u spreads over the
+//     tactel's footprint). The slope variances are the least-squares ones,
+//     (sigma_normal^2 + dq^2 / 12) times the diagonal of the inverse normal matrix.
+//  4. Position. The tactel centre pushed back by the corrected depth along the pad normal:
+//     T_world_pad * (x, y, -d).
+// Per pad, one contact per frame: a quadric d(x, y) = a + g . u + u' H u / 2 (u the offset from
+// the reading-weighted centroid of the active tactels) is fitted to their corrected depths
+// (a plane below six tactels, the mean below three), and the contact is the fitted surface
+// point above the centroid, with the fitted normal there and the fit's own variance of a and g.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "taxel/core/contact.hpp"
+#include "taxel/core/types.hpp"
+#include "taxel/sensor/pad.hpp"
+
+namespace taxel::sensor {
+
+/// How readings become contacts.
+struct ContactOptions {
+  ContactMode mode = ContactMode::per_tactel;  ///< a contact per active tactel, or per pad
+  bool local_normals = true;      ///< normals from the depth map (false: the pad normal)
+  bool correct_censoring = true;  ///< remove the truncation bias of near-threshold readings
+  /// Angular standard deviation [rad] of a normal slope that the depth map cannot measure
+  /// (too few active neighbours); > 0.
+  double fallback_normal_sigma = 0.15;
+
+  /// Throws std::invalid_argument naming the field out of range.
+  void validate() const {
+    if (!(fallback_normal_sigma > 0) || !std::isfinite(fallback_normal_sigma)) {
+      throw std::invalid_argument("ContactOptions::fallback_normal_sigma must be finite and > 0");
+    }
+  }
+};
+
+/// The truncation bias [m] of a reading of measured depth `m` [m] that survived a threshold at
+/// depth `t` [m] under Gaussian noise `sigma` [m]: sigma * lambda((t - m) / sigma), lambda the
+/// inverse Mills ratio. Zero when sigma is zero or the reading is far above the threshold.
+inline double truncation_bias(double m, double t, double sigma) noexcept {
+  if (!(sigma > 0)) return 0.0;
+  const double a = (t - m) / sigma;
+  if (a < -9.0) return 0.0;  // below 1e-17 sigma
+  const double survive = 0.5 * std::erfc(a * 0.7071067811865476);  // 1 - Phi(a)
+  const double density = 0.3989422804014327 * std::exp(-0.5 * a * a);
+  return sigma * density / survive;
+}
+
+/// Turns readings of one pad into contacts (see the model above). Holds a workspace, so
+/// repeated calls allocate nothing beyond what `out` grows by. Not thread-safe: one extractor
+/// per thread.
+class ContactExtractor {
+ public:
+  /// Throws std::invalid_argument for an invalid model or options.
+  explicit ContactExtractor(const SensorModel& model, const ContactOptions& options = {})
+      : model_(model), options_(options) {
+    model_.validate();
+    options_.validate();
+    const double dq = model_.depth_per_count();
+    // Selection is round(measured / dq) >= threshold, i.e. measured >= (threshold - 1/2) dq.
+    const double t = (model_.threshold - 0.5) * dq;
+    const int saturated = model_.levels - 1;
+    bias_.assign(static_cast<std::size_t>(saturated), 0.0);
+    if (options_.correct_censoring) {
+      for (int k = model_.threshold; k < saturated; ++k) {
+        const double b = truncation_bias(k * dq, t, model_.sigma_normal);
+        if (b == 0.0) break;
+        bias_[static_cast<std::size_t>(k)] = b;
+      }
+    }
+    depth_.assign(static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols, kNone);
+  }
+
+  /// Appends the contacts of `counts` (rows x cols readings) taken with the pad at
+  /// `T_world_pad` (pad -> world, as the robot believes it) at `time` [s] to `out`, in row-major
+  /// tactel order. Returns the number appended. Throws std::invalid_argument when `counts`
+  /// does not match the pad geometry or the pose is not finite.
+  std::size_t extract(const PadMatrix& counts, const Eigen::Isometry3d& T_world_pad, double time,
+                      std::vector<Contact<double>>& out) {
+    const PadGeometry& g = model_.geometry;
+    if (counts.rows() != g.rows || counts.cols() != g.cols) {
+      throw std::invalid_argument("ContactExtractor: readings are " +
+                                  std::to_string(counts.rows()) + " x " +
+                                  std::to_string(counts.cols()) + ", the pad is " +
+                                  std::to_string(g.rows) + " x " + std::to_string(g.cols));
+    }
+    if (!T_world_pad.matrix().allFinite()) {
+      throw std::invalid_argument("ContactExtractor: the pad pose is not finite");
+    }
+    const int saturated = model_.levels - 1;
+    const double dq = model_.depth_per_count();
+    std::size_t active = 0;
+    for (int r = 0; r < g.rows; ++r) {
+      for (int c = 0; c < g.cols; ++c) {
+        const int k = counts(r, c);
+        double& d = depth_[static_cast<std::size_t>(r) * g.cols + c];
+        if (k >= model_.threshold && k < saturated) {
+          d = k * dq - bias_[static_cast<std::size_t>(k)];
+          ++active;
+        } else {
+          d = kNone;
+        }
+      }
+    }
+    if (active == 0) return 0;
+    return options_.mode == ContactMode::per_tactel ? per_tactel(counts, T_world_pad, time, out)
+                                                    : per_pad(counts, T_world_pad, time, out);
+  }
+
+  /// The sensor model in use.
+  const SensorModel& model() const noexcept { return model_; }
+  /// The options in use.
+  const ContactOptions& options() const noexcept { return options_; }
+
+ private:
+  static constexpr double kNone = -std::numeric_limits<double>::infinity();
+
+  double depth_variance() const {
+    const double dq = model_.depth_per_count();
+    return model_.sigma_normal * model_.sigma_normal + dq * dq / 12.0;
+  }
+
+  // The contact at pad point (x, y, -depth) with outward normal n_pad (pad frame), extra
+  // variance along the normal and the slope variances of that normal.
+  Contact<double> make(const Eigen::Isometry3d& T, double x, double y, double depth,
+                       const Vec3d& n_pad, double var_along, double var_across, double slope_var,
+                       double pressure, double time) const {
+    const double lever2 = x * x + y * y;
+    const double st2 = model_.sigma_tilt * model_.sigma_tilt;
+    const double sp2 = model_.sigma_position * model_.sigma_position;
+    const double vt = var_across + sp2 + lever2 * st2 / 6.0;
+    const double q2 = model_.geometry.pitch * model_.geometry.pitch / 12.0;
+    const double vn = var_along + sp2 + lever2 * st2 / 3.0 + q2 * slope_var;
+    Contact<double> c;
+    c.position = T * Vec3d(x, y, -depth);
+    const Vec3d n = (T.linear() * n_pad).normalized();
+    c.covariance = Mat3d::Identity() * vt + (vn - vt) * (n * n.transpose());
+    c.normal = n;
+    c.pressure = pressure;
+    c.time = time;
+    return c;
+  }
+
+  std::size_t per_tactel(const PadMatrix& counts, const Eigen::Isometry3d& T, double time,
+                         std::vector<Contact<double>>& out) const {
+    const PadGeometry& g = model_.geometry;
+    const double p = g.pitch;
+    const double vd = depth_variance();
+    const double fb2 = options_.fallback_normal_sigma * options_.fallback_normal_sigma;
+    std::size_t added = 0;
+    for (int r = 0; r < g.rows; ++r) {
+      for (int c = 0; c < g.cols; ++c) {
+        const double d0 = depth_[static_cast<std::size_t>(r) * g.cols + c];
+        if (d0 == kNone) continue;
+        double gx = 0, gy = 0, vgx = 0, vgy = 0;  // slopes of d per metre and their variances
+        if (options_.local_normals) {
+          // Least-squares plane over the active 3x3 neighbourhood, in pitch units.
+          double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0, sd = 0, sxd = 0, syd = 0;
+          for (int dr = -1; dr <= 1; ++dr) {
+            const int rr = r + dr;
+            if (rr < 0 || rr >= g.rows) continue;
+            for (int dc = -1; dc <= 1; ++dc) {
+              const int cc = c + dc;
+              if (cc < 0 || cc >= g.cols) continue;
+              const double d = depth_[static_cast<std::size_t>(rr) * g.cols + cc];
+              if (d == kNone) continue;
+              n += 1;
+              sx += dc;
+              sy += dr;
+              sxx += dc * dc;
+              syy += dr * dr;
+              sxy += dc * dr;
+              sd += d;
+              sxd += dc * d;
+              syd += dr * d;
+            }
+          }
+          const double cxx = sxx - sx * sx / n, cyy = syy - sy * sy / n, cxy = sxy - sx * sy / n;
+          const double cxd = sxd - sx * sd / n, cyd = syd - sy * sd / n;
+          const double det = cxx * cyy - cxy * cxy;
+          constexpr double kTiny = 1e-9;
+          if (cxx > kTiny && cyy > kTiny && det > 0.1 * cxx * cyy) {
+            gx = (cyy * cxd - cxy * cyd) / det / p;
+            gy = (cxx * cyd - cxy * cxd) / det / p;
+            vgx = vd * cyy / det / (p * p);
+            vgy = vd * cxx / det / (p * p);
+          } else if (cxx > kTiny && std::abs(cxy) <= kTiny) {  // a row: x slope only
+            gx = cxd / cxx / p;
+            vgx = vd / cxx / (p * p);
+            vgy = fb2;
+          } else if (cyy > kTiny && std::abs(cxy) <= kTiny) {  // a column: y slope only
+            gy = cyd / cyy / p;
+            vgy = vd / cyy / (p * p);
+            vgx = fb2;
+          } else {
+            vgx = vgy = fb2;
+          }
+        }
+        const Vec3d n_pad = -Vec3d(gx, gy, 1.0).normalized();
+        const Vec3d at = g.tactel(r, c);
+        const int k = counts(r, c);
+        const double corr = bias_[static_cast<std::size_t>(k)];
+        out.push_back(make(T, at.x(), at.y(), d0, n_pad, vd + corr * corr, q2(), vgx + vgy,
+                           double(k), time));
+        ++added;
+      }
+    }
+    return added;
+  }
+
+  double q2() const { return model_.geometry.pitch * model_.geometry.pitch / 12.0; }
+
+  std::size_t per_pad(const PadMatrix& counts, const Eigen::Isometry3d& T, double time,
+                      std::vector<Contact<double>>& out) const {
+    const PadGeometry& g = model_.geometry;
+    const double p = g.pitch;
+    const double vd = depth_variance();
+    const double fb2 = options_.fallback_normal_sigma * options_.fallback_normal_sigma;
+    const double x0 = 0.5 * (g.cols - 1), y0 = 0.5 * (g.rows - 1);
+    // Reading-weighted centroid of the active tactels, in pitch units from the pad centre.
+    double w = 0, wx = 0, wy = 0, corr2 = 0;
+    int n = 0;
+    for (int r = 0; r < g.rows; ++r) {
+      for (int c = 0; c < g.cols; ++c) {
+        if (depth_[static_cast<std::size_t>(r) * g.cols + c] == kNone) continue;
+        const double k = counts(r, c);
+        w += k;
+        wx += k * (c - x0);
+        wy += k * (r - y0);
+        const double b = bias_[static_cast<std::size_t>(counts(r, c))];
+        corr2 += b * b;
+        ++n;
+      }
+    }
+    const double xc = wx / w, yc = wy / w;
+    // Least squares of the depths on 1, X, Y, X^2, XY, Y^2 (X, Y from the centroid): a quadric
+    // from six tactels, a plane from three, the mean below; a smaller model when the tactels
+    // do not determine the larger one (a pivot vanishes).
+    double sol[6] = {}, inv_diag[3] = {};
+    int m = n >= 6 ? 6 : (n >= 3 ? 3 : 1);
+    for (;; m = (m == 6 ? 3 : 1)) {
+      double ata[36] = {}, atb[6] = {};
+      for (int r = 0; r < g.rows; ++r) {
+        for (int c = 0; c < g.cols; ++c) {
+          const double d = depth_[static_cast<std::size_t>(r) * g.cols + c];
+          if (d == kNone) continue;
+          const double X = c - x0 - xc, Y = r - y0 - yc;
+          const double row[6] = {1.0, X, Y, X * X, X * Y, Y * Y};
+          for (int i = 0; i < m; ++i) {
+            atb[i] += row[i] * d;
+            for (int j = 0; j <= i; ++j) ata[i * 6 + j] += row[i] * row[j];
+          }
+        }
+      }
+      if (detail_cholesky(ata, m)) {
+        for (int i = 0; i < m; ++i) sol[i] = atb[i];
+        detail_solve(ata, m, sol);
+        for (int i = 0; i < std::min(m, 3); ++i) {
+          double e[6] = {};
+          e[i] = 1.0;
+          detail_solve(ata, m, e);
+          inv_diag[i] = e[i];
+        }
+        break;
+      }
+      if (m == 1) return 0;  // unreachable: n >= 1 active tactel gives a positive pivot
+    }
+    double gx = 0, gy = 0, slope_var = 2 * fb2;
+    if (m >= 3 && options_.local_normals) {
+      gx = sol[1] / p;
+      gy = sol[2] / p;
+      slope_var = vd * (inv_diag[1] + inv_diag[2]) / (p * p);
+    } else if (!options_.local_normals) {
+      slope_var = 0.0;
+    }
+    const Vec3d n_pad = -Vec3d(gx, gy, 1.0).normalized();
+    const double var_a = vd * inv_diag[0] + corr2 / (double(n) * n);
+    out.push_back(make(T, xc * p, yc * p, sol[0], n_pad, var_a, q2(), slope_var, w, time));
+    return 1;
+  }
+
+  // In-place Cholesky factor (lower triangle, row stride 6) of the leading m x m block; false
+  // when a pivot is not positive relative to its diagonal entry.
+  static bool detail_cholesky(double* a, int m) {
+    for (int j = 0; j < m; ++j) {
+      double djj = a[j * 6 + j];
+      for (int k = 0; k < j; ++k) djj -= a[j * 6 + k] * a[j * 6 + k];
+      if (!(djj > 1e-10 * a[j * 6 + j])) return false;
+      const double ljj = std::sqrt(djj);
+      a[j * 6 + j] = ljj;
+      for (int i = j + 1; i < m; ++i) {
+        double v = a[i * 6 + j];
+        for (int k = 0; k < j; ++k) v -= a[i * 6 + k] * a[j * 6 + k];
+        a[i * 6 + j] = v / ljj;
+      }
+    }
+    return true;
+  }
+  // Solves L L' x = b in place with the factor of detail_cholesky.
+  static void detail_solve(const double* l, int m, double* b) {
+    for (int i = 0; i < m; ++i) {
+      for (int k = 0; k < i; ++k) b[i] -= l[i * 6 + k] * b[k];
+      b[i] /= l[i * 6 + i];
+    }
+    for (int i = m - 1; i >= 0; --i) {
+      for (int k = i + 1; k < m; ++k) b[i] -= l[k * 6 + i] * b[k];
+      b[i] /= l[i * 6 + i];
+    }
+  }
+
+  SensorModel model_;
+  ContactOptions options_;
+  std::vector<double> bias_;   // truncation bias by reading count [m]
+  std::vector<double> depth_;  // corrected depth per tactel [m]; kNone when not active
+};
+
+}  // namespace taxel::sensor

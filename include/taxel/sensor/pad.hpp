@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: MIT
+// A tactile pad: its tactel layout and how its readings relate to indentation, with the noise
+// of the readings and of the pad's pose. Shared by the simulator, the drivers and the tools.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "taxel/core/types.hpp"
+
+namespace taxel::sensor {
+
+/// Tactel layout of a pad. Tactel (r, c) sits at x = (c - (cols - 1) / 2) pitch,
+/// y = (r - (rows - 1) / 2) pitch, z = 0 in the pad frame; the sensing face looks along +z
+/// (into the touched object). Default: a Weiss DSA 9205-like matrix, 14 rows x 6 columns at
+/// 3.4 mm.
+struct PadGeometry {
+  int rows = 14;          ///< tactel rows, >= 1
+  int cols = 6;           ///< tactel columns, >= 1
+  double pitch = 3.4e-3;  ///< centre-to-centre distance [m], > 0
+
+  /// Centre of tactel (r, c) in the pad frame [m].
+  Vec3d tactel(int r, int c) const {
+    return {(c - 0.5 * (cols - 1)) * pitch, (r - 0.5 * (rows - 1)) * pitch, 0.0};
+  }
+};
+
+/// How a pad turns indentation into readings, and the noise of the reading and of the pose.
+/// The pad is soft and the object rigid: a tactel pressed `d` into the object reads
+/// `d / full_scale_depth * (levels - 1)` counts (a linear, Winkler-foundation model) plus
+/// Gaussian depth noise of `sigma_normal`, rounded and clipped at `levels - 1`; readings below
+/// `threshold` are reported as zero (the noise floor), so they are censored, not missing.
+struct SensorModel {
+  PadGeometry geometry;
+  double full_scale_depth = 3e-3;  ///< indentation that saturates a tactel [m], > 0
+  int levels = 4096;               ///< reading levels (12-bit like the DSA), >= 2
+  int threshold = 8;               ///< readings below this are zero (noise floor), >= 1
+  double sigma_normal = 0.3e-3;    ///< depth noise of a touching tactel, along the normal [m]
+  double sigma_position = 0.2e-3;  ///< kinematic translation noise of the pad, per frame [m]
+  double sigma_tilt = 0.02;  ///< kinematic rotation noise of the pad, per frame: angle std [rad]
+
+  /// Depth of one reading count [m].
+  double depth_per_count() const { return full_scale_depth / double(levels - 1); }
+
+  /// Throws std::invalid_argument naming the first parameter out of range.
+  void validate() const {
+    const auto need = [](bool ok, const char* what) {
+      if (!ok) throw std::invalid_argument(std::string("SensorModel: ") + what);
+    };
+    need(geometry.rows >= 1 && geometry.cols >= 1, "rows and cols must be >= 1");
+    need(geometry.rows <= 4096 && geometry.cols <= 4096, "rows and cols must be <= 4096");
+    need(geometry.pitch > 0 && std::isfinite(geometry.pitch), "pitch must be finite and > 0");
+    need(full_scale_depth > 0 && std::isfinite(full_scale_depth),
+         "full_scale_depth must be finite and > 0");
+    need(levels >= 2 && levels <= 65536, "levels must be in [2, 65536]");
+    need(threshold >= 1 && threshold < levels, "threshold must be in [1, levels)");
+    need(sigma_normal >= 0 && std::isfinite(sigma_normal), "sigma_normal must be finite, >= 0");
+    need(sigma_position >= 0 && std::isfinite(sigma_position),
+         "sigma_position must be finite, >= 0");
+    need(sigma_tilt >= 0 && std::isfinite(sigma_tilt), "sigma_tilt must be finite, >= 0");
+  }
+};
+
+/// Readings of one pad as a row-major rows x cols matrix of counts.
+using PadMatrix = Eigen::Array<std::uint16_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// Contacts from a reading: one per active tactel, or one per pad and frame.
+enum class ContactMode { per_tactel, per_pad };
+
+}  // namespace taxel::sensor

@@ -1,0 +1,215 @@
+// SPDX-License-Identifier: MIT
+// Tests of the readings-to-contacts model (sensor/contacts.hpp): normals against closed forms on
+// plane, sphere and cylinder patches, the censoring bias, the orientation of the covariance, the
+// per-pad quadric contact, and bad input.
+#include <Eigen/Eigenvalues>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+#include <taxel/sensor.hpp>
+
+namespace tsn = taxel::sensor;
+using taxel::Vec3d;
+
+namespace {
+
+tsn::SensorModel noiseless() {
+  tsn::SensorModel m;
+  m.sigma_normal = 0.0;
+  m.sigma_position = 0.0;
+  m.sigma_tilt = 0.0;
+  m.levels = 65536;  // fine depth steps, so that closed forms hold to a micrometre
+  m.full_scale_depth = 6e-3;
+  return m;
+}
+
+// Readings of a pad whose tactel (r, c) is pressed depth(x, y) [m] (pad frame), rounded.
+template <class Depth>
+tsn::PadMatrix readings(const tsn::SensorModel& m, Depth depth) {
+  tsn::PadMatrix out(m.geometry.rows, m.geometry.cols);
+  const double per_count = m.depth_per_count();
+  for (int r = 0; r < m.geometry.rows; ++r) {
+    for (int c = 0; c < m.geometry.cols; ++c) {
+      const Vec3d t = m.geometry.tactel(r, c);
+      const double k = std::round(depth(t.x(), t.y()) / per_count);
+      out(r, c) = static_cast<std::uint16_t>(k >= m.threshold ? std::min(k, 65534.0) : 0.0);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("readings to contacts: normals of a tilted plane are exact", "[sensor]") {
+  const tsn::SensorModel m = noiseless();
+  tsn::ContactExtractor ex(m);
+  // Depth 2 mm + 0.1 x - 0.05 y: the surface z = -d has outward normal -(0.1, -0.05, 1)/|.|.
+  const auto counts = readings(m, [](double x, double y) { return 2e-3 + 0.1 * x - 0.05 * y; });
+  std::vector<taxel::Contact<double>> out;
+  REQUIRE(ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out) == 84);
+  const Vec3d expected = -Vec3d(0.1, -0.05, 1.0).normalized();
+  for (const auto& c : out) CHECK((*c.normal - expected).norm() < 1e-4);
+  SECTION("rotated and moved pad: the normal turns with it") {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(0.8, Vec3d(1, -2, 0.5).normalized()).matrix();
+    T.translation() = Vec3d(0.1, 0.2, -0.3);
+    std::vector<taxel::Contact<double>> turned;
+    ex.extract(counts, T, 0.0, turned);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      CHECK((*turned[i].normal - T.linear() * *out[i].normal).norm() < 1e-12);
+      CHECK((turned[i].position - T * out[i].position).norm() < 1e-12);
+    }
+  }
+  SECTION("without local normals every contact takes the pad normal") {
+    tsn::ContactExtractor flat(m, {.local_normals = false});
+    std::vector<taxel::Contact<double>> pad;
+    flat.extract(counts, Eigen::Isometry3d::Identity(), 0.0, pad);
+    for (const auto& c : pad) CHECK(c.normal->isApprox(-Vec3d::UnitZ()));
+  }
+}
+
+TEST_CASE("readings to contacts: normals on sphere and cylinder patches match the closed form",
+          "[sensor]") {
+  const tsn::SensorModel m = noiseless();
+  tsn::ContactExtractor ex(m);
+  const double delta = 1.5e-3;
+  // Sphere of radius R whose top is pressed delta into the pad (pad z looks into the object):
+  // the surface below tactel (x, y) is at depth d = delta - (R - sqrt(R^2 - x^2 - y^2)), and the
+  // outward normal there is (x, y, -(R - ...)) / R in the pad frame, i.e. (x, y, -sqrt(..)) / R.
+  for (const double R : {0.04, 0.015}) {
+    const auto depth = [&](double x, double y) {
+      const double r2 = x * x + y * y;
+      return r2 < R * R ? delta - (R - std::sqrt(R * R - r2)) : -1.0;
+    };
+    std::vector<taxel::Contact<double>> out;
+    ex.extract(readings(m, depth), Eigen::Isometry3d::Identity(), 0.0, out);
+    REQUIRE(out.size() >= 4);
+    double best = 1.0;
+    for (const auto& c : out) {
+      const Vec3d p = c.position;  // on the sphere centred at (0, 0, R - delta)
+      const Vec3d truth = (p - Vec3d(0, 0, R - delta)).normalized();
+      CHECK(std::abs((p - Vec3d(0, 0, R - delta)).norm() - R) < 1e-6);
+      // A full 3x3 neighbourhood gives central differences: error O(pitch^2 / R^2); at the rim
+      // of the patch the fit is one-sided in x and y: error up to about pitch / (sqrt(2) R).
+      const double err = std::acos(std::min(1.0, c.normal->dot(truth)));
+      CHECK(err < 3.4e-3 / (std::sqrt(2.0) * R) + 0.01);
+      best = std::min(best, err);
+    }
+    // On the 40 mm sphere the patch is wide enough for full neighbourhoods.
+    if (R == 0.04) CHECK(best < 0.01);
+  }
+  // Cylinder of radius R along the pad's y axis: depth delta - (R - sqrt(R^2 - x^2)); the normal
+  // has no y component.
+  const double R = 0.03;
+  std::vector<taxel::Contact<double>> out;
+  ex.extract(readings(m, [&](double x, double) { return delta - (R - std::sqrt(R * R - x * x)); }),
+             Eigen::Isometry3d::Identity(), 0.0, out);
+  REQUIRE(!out.empty());
+  for (const auto& c : out) {
+    const Vec3d p = c.position;
+    const Vec3d truth = Vec3d(p.x(), 0, p.z() - (R - delta)).normalized();
+    CHECK(std::abs(c.normal->y()) < 1e-9);
+    CHECK(std::acos(std::min(1.0, c.normal->dot(truth))) < 3.4e-3 / (std::sqrt(2.0) * R) + 0.01);
+  }
+}
+
+TEST_CASE("readings to contacts: the covariance is tight along the local normal", "[sensor]") {
+  tsn::SensorModel m;  // default noise
+  tsn::ContactExtractor ex(m);
+  const auto counts = readings(m, [](double x, double) { return 1e-3 + 0.2 * x; });
+  std::vector<taxel::Contact<double>> out;
+  ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out);
+  REQUIRE(!out.empty());
+  for (const auto& c : out) {
+    const Eigen::SelfAdjointEigenSolver<taxel::Mat3d> eig(c.covariance);
+    // Smallest eigenvalue's eigenvector is the normal; the other two are equal (the tangent
+    // plane) and equal to pitch^2/12 + sigma_position^2 + lever^2 sigma_tilt^2 / 6.
+    CHECK(std::abs(eig.eigenvectors().col(0).dot(*c.normal)) > 1 - 1e-9);
+    const Vec3d t = c.position;
+    const double lever2 = t.x() * t.x() + t.y() * t.y();
+    const double vt = 3.4e-3 * 3.4e-3 / 12 + 0.2e-3 * 0.2e-3 + lever2 * 0.02 * 0.02 / 6;
+    CHECK(eig.eigenvalues()(1) == Approx(vt).epsilon(1e-6));
+    CHECK(eig.eigenvalues()(2) == Approx(vt).epsilon(1e-6));
+    CHECK(eig.eigenvalues()(0) > 0.3e-3 * 0.3e-3);  // at least the depth noise
+    CHECK(taxel::check_contact(c) == taxel::ContactDefect::ok);
+  }
+}
+
+TEST_CASE("readings to contacts: the censoring correction removes the threshold's bias",
+          "[sensor]") {
+  // A flat pad pressed to a depth drawn uniformly in [0, 1 mm] per tactel, read with the
+  // default 0.3 mm noise and the noise floor: readings below the threshold are lost, so the
+  // survivors sit too deep; the correction brings the mean error back to about zero.
+  tsn::SensorModel m;
+  m.sigma_position = m.sigma_tilt = 0.0;
+  tsn::ContactExtractor corrected(m), plain(m, {.correct_censoring = false});
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1e-3);
+  double err_corrected = 0, err_plain = 0;
+  std::size_t n = 0;
+  for (int frame = 0; frame < 4000; ++frame) {
+    tsn::PadMatrix counts(14, 6), truth_counts(14, 6);
+    std::vector<double> truth(84);
+    for (int i = 0; i < 84; ++i) {
+      truth[i] = uniform(rng);
+      const double k = std::round((truth[i] + m.sigma_normal * gauss(rng)) / m.depth_per_count());
+      counts(i / 6, i % 6) = static_cast<std::uint16_t>(k >= m.threshold ? std::min(k, 4095.0) : 0);
+    }
+    std::vector<taxel::Contact<double>> a, b;
+    corrected.extract(counts, Eigen::Isometry3d::Identity(), 0.0, a);
+    plain.extract(counts, Eigen::Isometry3d::Identity(), 0.0, b);
+    REQUIRE(a.size() == b.size());
+    std::size_t k = 0;
+    for (int i = 0; i < 84; ++i) {
+      const int c = counts(i / 6, i % 6);
+      if (c < m.threshold || c >= 4095) continue;
+      // Depth is -z in the pad frame; the error is measured depth minus true depth.
+      err_corrected += -a[k].position.z() - truth[i];
+      err_plain += -b[k].position.z() - truth[i];
+      ++k;
+      ++n;
+    }
+  }
+  REQUIRE(n > 250000);
+  CHECK(err_plain / double(n) > 0.04e-3);               // about +0.052 mm
+  CHECK(std::abs(err_corrected / double(n)) < 0.005e-3);  // about +0.001 mm
+  CHECK(tsn::truncation_bias(10e-3, 0.0, 0.3e-3) == 0.0);
+  CHECK(tsn::truncation_bias(0.0, 0.0, 0.3e-3) == Approx(0.3e-3 * std::sqrt(2 / M_PI)));
+}
+
+TEST_CASE("readings to contacts: per pad, the quadric's point above the centroid", "[sensor]") {
+  const tsn::SensorModel m = noiseless();
+  tsn::ContactExtractor ex(m, {.mode = tsn::ContactMode::per_pad});
+  // A sphere of 40 mm pressed 1.5 mm: the pressure-weighted centroid of the active tactels,
+  // and the contact on the sphere above it (a chord average would lie inside).
+  const double R = 0.04, delta = 1.5e-3;
+  const auto depth = [&](double x, double y) {
+    return delta - (R - std::sqrt(R * R - x * x - y * y));
+  };
+  std::vector<taxel::Contact<double>> out;
+  REQUIRE(ex.extract(readings(m, depth), Eigen::Isometry3d::Identity(), 0.0, out) == 1);
+  const Vec3d centre(0, 0, R - delta);
+  CHECK(std::abs((out[0].position - centre).norm() - R) < 5e-6);
+  CHECK(out[0].normal->dot((out[0].position - centre).normalized()) > 1 - 1e-4);
+  CHECK(taxel::check_contact(out[0]) == taxel::ContactDefect::ok);
+}
+
+TEST_CASE("readings to contacts: bad input is refused", "[sensor]") {
+  using Catch::Matchers::Contains;
+  tsn::ContactExtractor ex{tsn::SensorModel{}};
+  std::vector<taxel::Contact<double>> out;
+  CHECK_THROWS_WITH(ex.extract(tsn::PadMatrix::Zero(3, 3), Eigen::Isometry3d::Identity(), 0, out),
+                    Contains("3 x 3"));
+  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+  bad.translation().x() = std::nan("");
+  CHECK_THROWS_WITH(ex.extract(tsn::PadMatrix::Zero(14, 6), bad, 0, out), Contains("not finite"));
+  CHECK_THROWS_WITH(tsn::ContactExtractor(tsn::SensorModel{}, {.fallback_normal_sigma = 0}),
+                    Contains("fallback_normal_sigma"));
+  tsn::SensorModel wrong;
+  wrong.threshold = 0;
+  CHECK_THROWS_WITH(tsn::ContactExtractor{wrong}, Contains("threshold"));
+  // Nothing active: no contact, nothing appended.
+  CHECK(ex.extract(tsn::PadMatrix::Zero(14, 6), Eigen::Isometry3d::Identity(), 0, out) == 0);
+  CHECK(out.empty());
+}
