@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Contact fusion end to end (nearest within radius + policy update + index move, or insert)
 // for every policy x index, on 200k-contact sliding explorations of a sphere, a cylinder and a
-// box; plus query-only replay and a 100k-point growth case. Peers in the same binary:
+// box; plus query-only replay, a 100k-point growth case, and readings to contacts per active
+// tactel. Peers in the same binary:
 // nanoflann's dynamic adaptor (DynamicKdTree) and brute force.
 //   ./fusion_bench --benchmark_filter='Fuse<tf::Kalman<double>, ti::VoxelHash'
 //       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
@@ -118,6 +119,7 @@ void Shapes(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 // One line per combination; a new policy or index is one more line.
+BENCHMARK_TEMPLATE(Fuse, tf::Surfel<double>, ti::VoxelHash<double>)->Apply(Shapes);
 BENCHMARK_TEMPLATE(Fuse, tf::Kalman<double>, ti::VoxelHash<double>)->Apply(Shapes);
 BENCHMARK_TEMPLATE(Fuse, tf::Kalman<float>, ti::VoxelHash<float>)->Apply(Shapes);
 BENCHMARK_TEMPLATE(Fuse, tf::Kalman<double>, ti::DynamicKdTree<double>)->Apply(Shapes);
@@ -132,5 +134,44 @@ BENCHMARK_TEMPLATE(QueryReplay, ti::VoxelHash<double>)->Apply(Shapes);
 BENCHMARK_TEMPLATE(QueryReplay, ti::DynamicKdTree<double>)->Apply(Shapes);
 BENCHMARK_TEMPLATE(Growth, ti::VoxelHash<double>)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(Growth, ti::DynamicKdTree<double>)->Unit(benchmark::kMillisecond);
+
+// Readings to contacts (sensor::ContactExtractor): the frames of a pad sliding over a sphere
+// and a box, per tactel and per pad; time per active tactel.
+void ReadingsToContacts(benchmark::State& state) {
+  const bool per_pad = state.range(1) != 0;
+  static std::map<int, std::vector<taxel::sim::PadReading>> cache;
+  auto& frames = cache[int(state.range(0))];
+  taxel::sim::ExplorationConfig cfg;
+  if (frames.empty()) {
+    const auto collect = [&](const auto& ex) {
+      for (const auto& f : ex.frames)
+        for (const auto& p : f.pads) frames.push_back(p);
+    };
+    if (state.range(0) == 0) {
+      collect(taxel::sim::explore_sliding(taxel::sim::Sphere(0.04), cfg, {.frames = 500}));
+    } else {
+      collect(taxel::sim::explore_sliding(taxel::sim::Box(), cfg, {.frames = 500}));
+    }
+  }
+  taxel::sensor::ContactExtractor extractor(
+      cfg.sensor, {.mode = per_pad ? taxel::sensor::ContactMode::per_pad
+                                   : taxel::sensor::ContactMode::per_tactel});
+  std::vector<taxel::Contact<double>> out;
+  out.reserve(frames.size() * 84);
+  std::size_t active = 0;
+  const auto lo = static_cast<std::uint16_t>(cfg.sensor.threshold);
+  const auto hi = static_cast<std::uint16_t>(cfg.sensor.levels - 1);
+  for (const auto& f : frames) active += std::size_t((f.counts >= lo && f.counts < hi).count());
+  for (auto _ : state) {
+    out.clear();
+    for (const auto& f : frames) extractor.extract(f.counts, f.believed_pose, 0.0, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["ns_per_active_tactel"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * active),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["active_per_frame"] = double(active) / double(frames.size());
+}
+BENCHMARK(ReadingsToContacts)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"box", "per_pad"});
 
 BENCHMARK_MAIN();

@@ -27,11 +27,14 @@ include/taxel/io/contacts_csv.hpp); CLOUD.ply gets the fused points with the fie
 "observations", "covariance_trace" and "last_time". Units: metres and seconds.
 
 options:
-  --policy kalman|average|raw           fusion policy (default kalman)
+  --policy surfel|kalman|average|raw    fusion policy (default surfel: a Kalman point that
+                    fits its patch's curvature from the contact normals and removes the
+                    chord sag; kalman: the plain per-point Kalman filter; average: running
+                    mean; raw: every contact kept)
   --index voxel-hash|kd-tree|brute-force   spatial index (default voxel-hash)
   --radius R        association radius [m] (default 0.0034, one DSA tactel pitch)
-  --gate CHI2       Kalman: Mahalanobis gate (e.g. 11.345 for 99 %; default none)
-  --process-noise Q Kalman: process noise [m] per update (default 0)
+  --gate CHI2       surfel, kalman: Mahalanobis gate (e.g. 11.345 for 99 %; default none)
+  --process-noise Q surfel, kalman: process noise [m] per update (default 0)
   --ascii           write ASCII PLY (default binary little-endian)
   -h, --help        show this help
 
@@ -40,7 +43,7 @@ Exit status: 0 on success, 1 for unreadable input, 2 for bad options.
 )usage";
 
 struct Options {
-  std::string policy = "kalman";
+  std::string policy = "surfel";
   std::string index = "voxel-hash";
   double radius = 3.4e-3;
   double gate = 0.0;
@@ -122,8 +125,9 @@ int main(int argc, char** argv) {
       return 0;
     } else if (a == "--policy") {
       o.policy = std::string(args.value());
-      if (o.policy != "kalman" && o.policy != "average" && o.policy != "raw") {
-        args.fail("--policy must be kalman, average or raw");
+      if (o.policy != "surfel" && o.policy != "kalman" && o.policy != "average" &&
+          o.policy != "raw") {
+        args.fail("--policy must be surfel, kalman, average or raw");
       }
     } else if (a == "--index") {
       o.index = std::string(args.value());
@@ -158,7 +162,8 @@ int main(int argc, char** argv) {
     tf::Kalman<double>::Config kc;
     kc.process_noise = o.process_noise;
     if (o.gate != 0.0) kc.gate_chi2 = o.gate;
-    return with_index<tf::Kalman<double>>(o, kc, contacts, args);
+    if (o.policy == "kalman") return with_index<tf::Kalman<double>>(o, kc, contacts, args);
+    return with_index<tf::Surfel<double>>(o, {.kalman = kc}, contacts, args);
   } catch (const std::invalid_argument& e) {  // a configuration the cloud refuses
     args.fail(e.what());
   }

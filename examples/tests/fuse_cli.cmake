@@ -34,7 +34,7 @@ run_tool("${TOOL}" 0 --gate 11.345 contacts.csv gated.ply)
 expect("${out}" "points 20\n")
 
 run_tool("${TOOL}" 2 --policy median contacts.csv x.ply)
-expect("${err}" "--policy must be kalman, average or raw")
+expect("${err}" "--policy must be surfel, kalman, average or raw")
 run_tool("${TOOL}" 2 --radius -1 contacts.csv x.ply)
 expect("${err}" "association_radius")
 run_tool("${TOOL}" 2 contacts.csv)
