@@ -69,7 +69,7 @@ std::string safe(std::string s) {
 }
 
 struct Study {
-  std::vector<double> contacts;              // checkpoints
+  std::vector<double> contacts;                      // checkpoints
   std::vector<double> raw, average, kalman, surfel;  // RMS error [mm] at each checkpoint
 };
 
@@ -97,9 +97,8 @@ void study(const char* name, const Shape& shape, std::size_t n, const sim::Slidi
   const auto line = [&](const char* policy, const Row& r) {
     std::printf("%-26s %-8s %7zu %6.1fx %+8.3f %7.3f %7.3f %7.2f %5.1f%% | %6zu %7.3f\n", name,
                 policy, r.m.points, r.m.compaction, 1e3 * r.m.error.signed_mean,
-                1e3 * r.m.error.mean, 1e3 * r.m.error.rms,
-                1e3 * r.m.error.max, 100.0 * r.m.coverage, r.confirmed_points,
-                1e3 * r.confirmed.rms);
+                1e3 * r.m.error.mean, 1e3 * r.m.error.rms, 1e3 * r.m.error.max,
+                100.0 * r.m.coverage, r.confirmed_points, 1e3 * r.confirmed.rms);
   };
   const std::string stem = out.empty() ? std::string() : (out / safe(name)).string();
   const auto file = [&](const char* policy) {
@@ -139,8 +138,8 @@ template <class Shape>
 void pad_study(const char* name, const Shape& shape, bool quick, sim::ContactMode mode,
                bool print_header, PadTotals& totals) {
   if (print_header) {
-    std::printf("%-26s %-10s %4s %8s | %-15s | %-15s | %-15s | %-15s\n", "shape", "contacts", "seed",
-                "", "raw rms/signed", "average", "kalman", "surfel (default)");
+    std::printf("%-26s %-10s %4s %8s | %-15s | %-15s | %-15s | %-15s\n", "shape", "contacts",
+                "seed", "", "raw rms/signed", "average", "kalman", "surfel (default)");
   }
   constexpr double kGate = 4e-3;  // 4 sigma of the in-plane quantisation (0.98 mm)
   const int scale = quick ? 1 : 4;
@@ -268,17 +267,15 @@ int main(int argc, char** argv) try {
   plot.x_label = "contacts (thousands)";
   plot.y_label = "RMS error (mm)";
   plot.y_min = 0.0;
-  plot.series = {
-      {"raw", {}, curve.raw},
-      {"average", {}, curve.average},
-      {"kalman", {}, curve.kalman},
-      {"surfel", {}, curve.surfel}};
+  plot.series = {{"raw", {}, curve.raw},
+                 {"average", {}, curve.average},
+                 {"kalman", {}, curve.kalman},
+                 {"surfel", {}, curve.surfel}};
   for (auto& s : plot.series) {
     for (const double c : curve.contacts) s.x.push_back(c / 1000.0);
   }
   io::write_file((out / "error_vs_contacts.svg").string(), io::render_svg(plot));
-  std::printf("%-10s %9s %9s %9s %9s\n", "contacts", "raw mm", "avg mm", "kalman mm",
-              "surfel mm");
+  std::printf("%-10s %9s %9s %9s %9s\n", "contacts", "raw mm", "avg mm", "kalman mm", "surfel mm");
   for (std::size_t k = 0; k < curve.contacts.size(); ++k) {
     std::printf("%-10.0f %9.3f %9.3f %9.3f %9.3f\n", curve.contacts[k], curve.raw[k],
                 curve.average[k], curve.kalman[k], curve.surfel[k]);

@@ -482,8 +482,8 @@ TEST_CASE("Frames to contacts and images", "[drivers][convert]") {
   // (0.3 mm noise, threshold 8): sigma * phi(a) / (1 - Phi(a)), a = (7.5 - 1000) / 4095 * 3 mm
   // / 0.3 mm.
   const double dq = 3e-3 / 4095, a = (7.5 * dq - 1000 * dq) / 0.3e-3;
-  const double correction = 0.3e-3 * std::exp(-0.5 * a * a) / std::sqrt(2 * M_PI) /
-                            (0.5 * std::erfc(a / std::sqrt(2.0)));
+  const double correction =
+      0.3e-3 * std::exp(-0.5 * a * a) / std::sqrt(2 * M_PI) / (0.5 * std::erfc(a / std::sqrt(2.0)));
   for (const auto& c : contacts) {
     CHECK(c.position.z() == Approx(-1000.0 * dq + correction).epsilon(1e-9));
     CHECK(c.time == 0.5);

@@ -534,7 +534,8 @@ TEST_CASE("Surfel fits the curvature of a cylinder patch", "[fusion]") {
   const auto make = [&] {
     const double phi = u(rng) / R, z = u(rng);
     const taxel::Vec3d n(std::cos(phi), std::sin(phi), 0);
-    auto c = contact_at<double>(R * n + taxel::Vec3d(0, 0, z), taxel::pad_covariance(n, 3e-4, 1e-3));
+    auto c =
+        contact_at<double>(R * n + taxel::Vec3d(0, 0, z), taxel::pad_covariance(n, 3e-4, 1e-3));
     c.normal = n;
     return c;
   };

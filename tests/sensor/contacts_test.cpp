@@ -172,7 +172,7 @@ TEST_CASE("readings to contacts: the censoring correction removes the threshold'
     }
   }
   REQUIRE(n > 250000);
-  CHECK(err_plain / double(n) > 0.04e-3);               // about +0.052 mm
+  CHECK(err_plain / double(n) > 0.04e-3);                 // about +0.052 mm
   CHECK(std::abs(err_corrected / double(n)) < 0.005e-3);  // about +0.001 mm
   CHECK(tsn::truncation_bias(10e-3, 0.0, 0.3e-3) == 0.0);
   CHECK(tsn::truncation_bias(0.0, 0.0, 0.3e-3) == Approx(0.3e-3 * std::sqrt(2 / M_PI)));

@@ -49,23 +49,24 @@ struct Surfel {
   /// Configuration; defaults suit tactile pads of a few millimetres pitch.
   struct Config {
     typename Kalman<S>::Config kalman{};  ///< process noise, gate and P0 of the filter
-    S max_normal_angle = S(1.2);  ///< contacts turned further [rad] are not curvature data, in (0, pi/2)
-    S normal_sigma = S(0.05);       ///< noise of a contact normal [rad], > 0
-    S curvature_prior = S(100);     ///< prior standard deviation of the curvature [1/m], > 0
+    S max_normal_angle =
+        S(1.2);  ///< contacts turned further [rad] are not curvature data, in (0, pi/2)
+    S normal_sigma = S(0.05);    ///< noise of a contact normal [rad], > 0
+    S curvature_prior = S(100);  ///< prior standard deviation of the curvature [1/m], > 0
   };
   /// A fused point: the Kalman state, its tangent frame and the curvature sums.
   struct State {
     typename Kalman<S>::State kalman;
-    Vec3<S> origin;       ///< frame origin [m]: the first contact with a normal
-    Vec3<S> n0;           ///< frame normal (zero until a contact with a normal arrives)
-    Vec3<S> t1;           ///< first tangent of the frame; the second is n0 x t1
-    Vec3<S> normal_sum;   ///< sum of the accepted contact normals
-    S count;              ///< contacts in the sums
-    S weight;             ///< sum of their weights w (information along the normal) [1/m^2]
-    S sz;                 ///< w-weighted sum of the heights z along n0 [m]
-    S su[2], ss[2];       ///< w-weighted sums of u [m] and s [-]
-    S suu[3];             ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
-    S ssu[4];             ///< w-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
+    Vec3<S> origin;      ///< frame origin [m]: the first contact with a normal
+    Vec3<S> n0;          ///< frame normal (zero until a contact with a normal arrives)
+    Vec3<S> t1;          ///< first tangent of the frame; the second is n0 x t1
+    Vec3<S> normal_sum;  ///< sum of the accepted contact normals
+    S count;             ///< contacts in the sums
+    S weight;            ///< sum of their weights w (information along the normal) [1/m^2]
+    S sz;                ///< w-weighted sum of the heights z along n0 [m]
+    S su[2], ss[2];      ///< w-weighted sums of u [m] and s [-]
+    S suu[3];            ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
+    S ssu[4];            ///< w-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
   };
   static constexpr bool kMerges = true;
 

@@ -74,7 +74,7 @@ struct ContactOptions {
 inline double truncation_bias(double m, double t, double sigma) noexcept {
   if (!(sigma > 0)) return 0.0;
   const double a = (t - m) / sigma;
-  if (a < -9.0) return 0.0;  // below 1e-17 sigma
+  if (a < -9.0) return 0.0;                                        // below 1e-17 sigma
   const double survive = 0.5 * std::erfc(a * 0.7071067811865476);  // 1 - Phi(a)
   const double density = 0.3989422804014327 * std::exp(-0.5 * a * a);
   return sigma * density / survive;
@@ -234,8 +234,8 @@ class ContactExtractor {
         const Vec3d at = g.tactel(r, c);
         const int k = counts(r, c);
         const double corr = bias_[static_cast<std::size_t>(k)];
-        out.push_back(make(T, at.x(), at.y(), d0, n_pad, vd + corr * corr, q2(), vgx + vgy,
-                           double(k), time));
+        out.push_back(
+            make(T, at.x(), at.y(), d0, n_pad, vd + corr * corr, q2(), vgx + vgy, double(k), time));
         ++added;
       }
     }

@@ -26,10 +26,10 @@ namespace taxel::sim {
 
 /// Settings shared by every exploration.
 struct ExplorationConfig {
-  SensorModel sensor;                          ///< the pads (all pads of a hand are alike)
+  SensorModel sensor;                 ///< the pads (all pads of a hand are alike)
   sensor::ContactOptions contacts{};  ///< how readings become contacts (per tactel or per pad)
-  double frame_rate = 1000.0;                  ///< frames per second [Hz], > 0
-  double indentation = 1.0e-3;                 ///< how far a pad presses into the object [m], > 0
+  double frame_rate = 1000.0;         ///< frames per second [Hz], > 0
+  double indentation = 1.0e-3;        ///< how far a pad presses into the object [m], > 0
   Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  ///< shape frame -> world
   std::uint64_t seed = 1;                                         ///< equal seeds, equal output
 

@@ -108,11 +108,12 @@ std::vector<Contact<double>> sliding_exploration(const Sh& shape, std::size_t co
 struct SurfaceError {
   double signed_mean = 0;  ///< mean signed distance (outside positive): the bias
   double mean = 0;         ///< mean |signed distance|
-  double rms = 0;   ///< root mean square signed distance
-  double max = 0;   ///< largest |signed distance|
+  double rms = 0;          ///< root mean square signed distance
+  double max = 0;          ///< largest |signed distance|
 };
 
-/// Signed mean, mean, RMS and max distance of `points` to the surface of `shape`; zeros for no points.
+/// Signed mean, mean, RMS and max distance of `points` to the surface of `shape`; zeros for no
+/// points.
 template <Shape Sh, class Points>
 SurfaceError surface_error(const Sh& shape, const Points& points) {
   SurfaceError e;
