@@ -163,8 +163,7 @@ class ContactExtractor {
     const double st2 = model_.sigma_tilt * model_.sigma_tilt;
     const double sp2 = model_.sigma_position * model_.sigma_position;
     const double vt = var_across + sp2 + lever2 * st2 / 6.0;
-    const double q2 = model_.geometry.pitch * model_.geometry.pitch / 12.0;
-    const double vn = var_along + sp2 + lever2 * st2 / 3.0 + q2 * slope_var;
+    const double vn = var_along + sp2 + lever2 * st2 / 3.0 + q2() * slope_var;
     Contact<double> c;
     c.position = T * Vec3d(x, y, -depth);
     const Vec3d n = (T.linear() * n_pad).normalized();
