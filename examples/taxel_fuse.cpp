@@ -2,6 +2,7 @@
 // taxel-fuse: a contact stream (CSV) in, the fused cloud (PLY) out, with the fusion policy and
 // the spatial index chosen by option.
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <limits>
@@ -12,6 +13,10 @@
 #include <taxel/index.hpp>
 #include <taxel/io/contacts_csv.hpp>
 #include <taxel/io/ply.hpp>
+#include <taxel/sensor/readings.hpp>
+// The drivers' headers used here (session replay, frames to contacts) need no libusb.
+#include <taxel/drivers/convert.hpp>
+#include <taxel/drivers/session.hpp>
 #include <vector>
 
 #include "cli.hpp"
@@ -19,12 +24,29 @@
 namespace {
 
 constexpr const char* kUsage = R"usage(usage: taxel-fuse [options] CONTACTS.csv CLOUD.ply
+       taxel-fuse [options] --readings STACK.npy --poses POSES.csv CLOUD.ply
+       taxel-fuse [options] --session SESSION.txt [--poses POSES.csv] CLOUD.ply
 
 Fuses a contact stream into a compact cloud: each contact joins the nearest fused point within
-the association radius, or starts a new one. CONTACTS.csv has a header naming its columns
+the association radius, or starts a new one. The contacts come from a CSV, or from pad
+readings and the pads' poses, turned into contacts by taxel's sensor model (a local surface
+normal from each pad's depth map, the noise floor's censoring removed, the covariance tight
+along that normal; include/taxel/sensor/contacts.hpp).
+
+STACK.npy is a numpy array of integer readings of shape (frames, rows, cols) for one pad or
+(frames, pads, rows, cols); POSES.csv has the header frame,pad,x,y,z,qw,qx,qy,qz[,time]: per
+frame and pad, the pad origin [m] and the pad -> world rotation as a unit quaternion (the pad
+frame: tactel rows along y, columns along x, the sensing face along +z, into the object). A pad
+that reads contact must have a pose. SESSION.txt is a DSACON32m session recorded by
+taxel-record; its matrices' geometry comes from the controller, their poses from POSES.csv (as
+taxel-record --poses writes it, columns time_ms,matrix,...) or else the controller's static
+matrix poses.
+
+CONTACTS.csv has a header naming its columns
 (time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure; x, y, z required; see
-include/taxel/io/contacts_csv.hpp); CLOUD.ply gets the fused points with the fields
-"observations", "covariance_trace" and "last_time". Units: metres and seconds.
+include/taxel/io/contacts_csv.hpp); CLOUD.ply gets the fused points with their normals (surfel)
+and the properties "observations", the covariance "cov_xx", "cov_xy", "cov_xz", "cov_yy",
+"cov_yz", "cov_zz" [m^2] and "last_time". Units: metres and seconds.
 
 options:
   --policy surfel|kalman|average|raw    fusion policy (default surfel: a Kalman point that
@@ -35,10 +57,23 @@ options:
   --radius R        association radius [m] (default 0.0034, one DSA tactel pitch)
   --gate CHI2       surfel, kalman: Mahalanobis gate (e.g. 11.345 for 99 %; default none)
   --process-noise Q surfel, kalman: process noise [m] per update (default 0)
-  --ascii           write ASCII PLY (default binary little-endian)
+  --min-observations N   keep only points with at least N contacts (default 1: all)
+  --max-sigma S     keep only points whose largest standard deviation is at most S [m]
+  --ascii           write ASCII PLY
+readings (--readings, --session):
+  --per-pad         one contact per pad and frame (default: one per active tactel)
+  --pitch P         tactel pitch [m] (default 0.0034; --readings only)
+  --levels L        reading levels, e.g. 4096 for 12 bits (default 4096; --readings only)
+  --full-scale-depth D   indentation at the largest reading [m] (default 0.003)
+  --threshold T     readings below T are no contact (default 8)
+  --sigma-normal S  depth noise of a reading [m] (default 0.0003)
+  --sigma-position S  pad position noise from the kinematics [m] (default 0.0002)
+  --sigma-tilt S    pad rotation noise from the kinematics [rad] (default 0.02)
+  --frame-rate F    frames per second, for poses without a time (default 1000) (default binary little-endian)
   -h, --help        show this help
 
-Prints the counts (contacts, added, fused, rejected by reason) and the time per contact.
+Prints the counts (contacts, added, fused, rejected by reason, points, points written) and the
+time per contact.
 Exit status: 0 on success, 1 for unreadable input, 2 for bad options.
 )usage";
 
@@ -49,6 +84,12 @@ struct Options {
   double gate = 0.0;
   double process_noise = 0.0;
   bool ascii = false;
+  std::uint32_t min_observations = 1;
+  std::string readings, poses, session;
+  bool per_pad = false;
+  double frame_rate = 1000.0;
+  taxel::sensor::SensorModel model;
+  double max_sigma = std::numeric_limits<double>::infinity();
   std::vector<std::string> files;
 };
 
@@ -82,9 +123,11 @@ int fuse(const Options& o, typename Cloud::Config cfg,
   for (const auto& [why, n] : rejected) std::printf(" (%s %zu)", why.c_str(), n);
   std::printf("\npoints %zu\ntime %.0f ns per contact\n", cloud.size(),
               contacts.empty() ? 0.0 : 1e9 * s / static_cast<double>(contacts.size()));
+  const auto kept = cloud.to_point_cloud({o.min_observations, o.max_sigma});
+  std::printf("written %zu\n", kept.size());
   try {
     taxel::io::write_ply(
-        o.files[1], cloud.to_point_cloud(),
+        o.files[1], kept,
         o.ascii ? taxel::io::PlyFormat::ascii : taxel::io::PlyFormat::binary_little_endian);
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
@@ -110,6 +153,45 @@ int with_index(const Options& o, typename Policy::Config pc,
   typename tf::ContactCloud<Policy, ti::VoxelHash<double>>::Config cfg;
   cfg.fusion = pc;
   return fuse<tf::ContactCloud<Policy, ti::VoxelHash<double>>>(o, cfg, contacts, args);
+}
+
+// The contacts of a recorded DSACON32m session: each frame's matrices at the poses of the frame's
+// time stamp in POSES.csv (as taxel-record --poses writes them), else at the controller's static
+// matrix poses. Throws on a malformed file or a replay that fails.
+void session_contacts(const Options& o, const taxel::sensor::ContactOptions& copt,
+                      std::vector<taxel::Contact<double>>& out) {
+  namespace td = taxel::drivers;
+  std::map<std::uint32_t, std::vector<Eigen::Isometry3d>> by_time;
+  if (!o.poses.empty()) {
+    const std::string text = taxel::io::read_file(o.poses);
+    for (const auto& p : taxel::io::parse_pad_poses_csv(text, o.poses)) {
+      auto& v = by_time[static_cast<std::uint32_t>(std::lround(p.time * 1e3))];
+      if (v.size() <= p.pad) v.resize(p.pad + 1, Eigen::Isometry3d::Identity());
+      v[p.pad] = p.pose;
+    }
+  }
+  td::DsaconDevice dev(td::ReplayTransport::from_file(o.session),
+                       {.frame_timeout = td::Timeout(50)});
+  dev.open();
+  const std::vector<Eigen::Isometry3d> fixed = td::static_matrix_poses(dev.matrices());
+  td::PadCalibration cal;
+  cal.full_scale_depth = o.model.full_scale_depth;
+  cal.threshold = o.model.threshold;
+  cal.sigma_normal = o.model.sigma_normal;
+  cal.sigma_position = o.model.sigma_position;
+  cal.sigma_tilt = o.model.sigma_tilt;
+  dev.start();
+  std::size_t frames = 0, posed = 0;
+  while (const auto f = dev.read_frame()) {
+    ++frames;
+    const auto it = by_time.find(f->device_time_ms);
+    const bool have = it != by_time.end() && it->second.size() == dev.matrices().size();
+    posed += have ? 1 : 0;
+    td::frame_contacts(*f, dev.matrices(), have ? it->second : fixed, out, copt.mode, cal, copt);
+  }
+  dev.close();
+  std::printf("session %zu frames (with poses %zu) of %zu matrices\n", frames, posed,
+              dev.matrices().size());
 }
 
 }  // namespace
@@ -140,18 +222,74 @@ int main(int argc, char** argv) {
       o.gate = args.number<double>(-kInf, kInf);
     } else if (a == "--process-noise") {
       o.process_noise = args.number<double>(-kInf, kInf);
+    } else if (a == "--min-observations") {
+      o.min_observations = args.number<std::uint32_t>(1, 4294967295u);
+    } else if (a == "--max-sigma") {
+      o.max_sigma = args.number<double>(0.0, kInf);
     } else if (a == "--ascii") {
       o.ascii = true;
+    } else if (a == "--readings") {
+      o.readings = std::string(args.value());
+    } else if (a == "--poses") {
+      o.poses = std::string(args.value());
+    } else if (a == "--session") {
+      o.session = std::string(args.value());
+    } else if (a == "--per-pad") {
+      o.per_pad = true;
+    } else if (a == "--pitch") {
+      o.model.geometry.pitch = args.number<double>(0.0, kInf);
+    } else if (a == "--levels") {
+      o.model.levels = args.number<int>(2, 65536);
+    } else if (a == "--full-scale-depth") {
+      o.model.full_scale_depth = args.number<double>(0.0, kInf);
+    } else if (a == "--threshold") {
+      o.model.threshold = args.number<int>(1, 65535);
+    } else if (a == "--sigma-normal") {
+      o.model.sigma_normal = args.number<double>(0.0, kInf);
+    } else if (a == "--sigma-position") {
+      o.model.sigma_position = args.number<double>(0.0, kInf);
+    } else if (a == "--sigma-tilt") {
+      o.model.sigma_tilt = args.number<double>(0.0, kInf);
+    } else if (a == "--frame-rate") {
+      o.frame_rate = args.number<double>(0.0, kInf);
     } else if (a.size() > 1 && a[0] == '-') {
       args.fail("unknown option '" + std::string(a) + "' (see --help)");
     } else {
       o.files.emplace_back(a);
     }
   }
-  if (o.files.size() != 2) args.fail("expected CONTACTS.csv and CLOUD.ply (see --help)");
+  const bool from_readings = !o.readings.empty(), from_session = !o.session.empty();
+  if (from_readings && from_session) args.fail("--readings and --session exclude each other");
+  if (from_readings && o.poses.empty()) args.fail("--readings needs --poses POSES.csv");
+  if (!from_readings && !from_session && !o.poses.empty()) {
+    args.fail("--poses goes with --readings or --session");
+  }
+  const std::size_t want = from_readings || from_session ? 1 : 2;
+  if (o.files.size() != want) {
+    args.fail(want == 1 ? "expected CLOUD.ply after the readings options (see --help)"
+                        : "expected CONTACTS.csv and CLOUD.ply (see --help)");
+  }
+  if (want == 1) o.files.insert(o.files.begin(), std::string());
   std::vector<taxel::Contact<double>> contacts;
+  taxel::sensor::ContactOptions copt;
+  copt.mode =
+      o.per_pad ? taxel::sensor::ContactMode::per_pad : taxel::sensor::ContactMode::per_tactel;
   try {
-    contacts = taxel::io::read_contacts_csv(o.files[0]);
+    if (from_readings) {
+      auto stack = taxel::sensor::ReadingStack::from_npy(taxel::io::read_npy_u16(o.readings));
+      const auto poses = taxel::io::read_pad_poses_csv(o.poses);
+      taxel::sensor::SensorModel model = o.model;
+      model.geometry.rows = static_cast<int>(stack.rows);
+      model.geometry.cols = static_cast<int>(stack.cols);
+      const auto r =
+          taxel::sensor::contacts_from_readings(stack, poses, model, copt, o.frame_rate, contacts);
+      std::printf("readings %zu frames x %zu pads of %zu x %zu\npad frames %zu (touching %zu)\n",
+                  stack.frames, stack.pads, stack.rows, stack.cols, r.pad_frames, r.touching);
+    } else if (from_session) {
+      session_contacts(o, copt, contacts);
+    } else {
+      contacts = taxel::io::read_contacts_csv(o.files[0]);
+    }
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }

@@ -11,6 +11,8 @@
 #include <string_view>
 #include <system_error>
 #include <taxel/io/contacts_csv.hpp>
+#include <taxel/io/npy.hpp>
+#include <taxel/io/pad_poses_csv.hpp>
 #include <taxel/io/ply.hpp>
 #include <taxel/sim.hpp>
 #include <vector>
@@ -28,12 +30,16 @@ default): sliding, grasps of a multi-finger hand, or palpation. Each pad frame t
 into 12-bit readings with depth noise; the pose has kinematic noise. Writes the contacts, with
 the anisotropic covariance the noise implies, the normal, pressure and time, as CSV for
 taxel-fuse. TRUTH.ply, when given, gets points sampled uniformly over the true surface (at its
-pose) with their normals. Units: metres, seconds, radians.
+pose) with their normals. With --readings and --poses it also writes what a real sensor gives:
+the frames' readings as a numpy array (frames, pads, rows, cols) of uint16 and each pad's pose
+per frame as the robot believes it (kinematic noise included), the input of taxel-fuse
+--readings. Units: metres, seconds, radians.
 
 options:
-  --shape sphere|cylinder|box|cone|mesh   (default sphere)
+  --shape sphere|cylinder|box|cone|ellipsoid|torus|mesh   (default sphere)
   --size A[,B[,C]]   sphere: radius (0.04); cylinder: radius, half height (0.03,0.05);
-                     box: half extents (0.04,0.03,0.02); cone: radius, height (0.03,0.06)
+                     box: half extents (0.04,0.03,0.02); cone: radius, height (0.03,0.06);
+                     ellipsoid: semi-axes (0.05,0.035,0.025); torus: R, r (0.04,0.015)
   --mesh FILE.ply    the mesh of --shape mesh (closed, outward-oriented triangles)
   --pose X,Y,Z[,RX,RY,RZ]  the object's position and rotation vector (default the origin)
   --exploration sliding|grasp|palpation   (default sliding)
@@ -55,6 +61,8 @@ options:
   --frame-rate HZ    (default 1000)
   --seed S           (default 1)
   --truth-points N   samples of the true surface in TRUTH.ply (default 10000)
+  --readings F.npy   also write the readings of the frames that gave the contacts
+  --poses F.csv      also write the pads' believed poses (frame,pad,x,y,z,qw,qx,qy,qz,time)
   -h, --help         show this help
 
 Exit status: 0 on success, 1 for unreadable or unwritable files, 2 for bad options.
@@ -71,6 +79,7 @@ struct Options {
   ts::GraspParams grasp;
   ts::PalpationParams palpation;
   std::size_t truth_points = 10000;
+  std::string readings, poses;
   std::vector<std::string> files;
 };
 
@@ -128,18 +137,36 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
     args.fail("the exploration touched the shape too rarely for " + std::to_string(o.contacts) +
               " contacts (got " + std::to_string(contacts.size()) + ")");
   }
+  std::size_t frames = 0;
+  for (const auto& f : ex.frames) {
+    if (!contacts.empty() && f.time > contacts.back().time) break;
+    ++frames;
+  }
   try {
     taxel::io::write_contacts_csv(o.files[0], contacts);
     if (o.files.size() > 1) {
       taxel::io::write_ply(o.files[1], ts::sample_surface(ex.truth, o.truth_points, o.config.seed));
     }
+    if (!o.readings.empty() || !o.poses.empty()) {
+      const auto& g = o.config.sensor.geometry;
+      const std::size_t pads = frames > 0 ? ex.frames[0].pads.size() : 0;
+      std::vector<std::uint16_t> values;
+      std::vector<taxel::io::PadPose> poses;
+      for (std::size_t f = 0; f < frames; ++f) {
+        for (std::size_t p = 0; p < pads; ++p) {
+          const auto& pad = ex.frames[f].pads[p];
+          values.insert(values.end(), pad.counts.data(), pad.counts.data() + pad.counts.size());
+          poses.push_back({f, p, ex.frames[f].time, pad.believed_pose});
+        }
+      }
+      const std::size_t dims[4] = {frames, pads, std::size_t(g.rows), std::size_t(g.cols)};
+      if (!o.readings.empty()) {
+        taxel::io::write_file(o.readings, taxel::io::encode_npy_u16(dims, values));
+      }
+      if (!o.poses.empty()) taxel::io::write_file(o.poses, taxel::io::encode_pad_poses_csv(poses));
+    }
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
-  }
-  std::size_t frames = 0;
-  for (const auto& f : ex.frames) {
-    if (!contacts.empty() && f.time > contacts.back().time) break;
-    ++frames;
   }
   std::printf("shape %s\nexploration %s\ncontacts %zu\nframes %zu\n", o.shape.c_str(),
               o.exploration.c_str(), contacts.size(), frames);
@@ -161,8 +188,8 @@ int main(int argc, char** argv) {
     } else if (a == "--shape") {
       o.shape = std::string(args.value());
       if (o.shape != "sphere" && o.shape != "cylinder" && o.shape != "box" && o.shape != "cone" &&
-          o.shape != "mesh") {
-        args.fail("--shape must be sphere, cylinder, box, cone or mesh");
+          o.shape != "ellipsoid" && o.shape != "torus" && o.shape != "mesh") {
+        args.fail("--shape must be sphere, cylinder, box, cone, ellipsoid, torus or mesh");
       }
     } else if (a == "--size") {
       o.size = numbers(args, "--size", args.value());
@@ -227,6 +254,10 @@ int main(int argc, char** argv) {
       o.config.frame_rate = args.number<double>(-kInf, kInf);
     } else if (a == "--seed") {
       o.config.seed = args.number<std::uint64_t>(0, std::numeric_limits<std::uint64_t>::max());
+    } else if (a == "--readings") {
+      o.readings = std::string(args.value());
+    } else if (a == "--poses") {
+      o.poses = std::string(args.value());
     } else if (a == "--truth-points") {
       o.truth_points = args.number<std::size_t>(1, std::size_t{1} << 26);
     } else if (a.size() > 1 && a[0] == '-') {
@@ -261,6 +292,14 @@ int main(int argc, char** argv) {
     if (o.shape == "cone") {
       const auto d = dims(2, {0.03, 0.06});
       return run(o, ts::Cone(d[0], d[1]), args);
+    }
+    if (o.shape == "ellipsoid") {
+      const auto d = dims(3, {0.05, 0.035, 0.025});
+      return run(o, ts::Ellipsoid(taxel::Vec3d(d[0], d[1], d[2])), args);
+    }
+    if (o.shape == "torus") {
+      const auto d = dims(2, {0.04, 0.015});
+      return run(o, ts::Torus(d[0], d[1]), args);
     }
     taxel::io::PlyData ply;
     try {

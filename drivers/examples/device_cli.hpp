@@ -14,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <taxel/drivers/convert.hpp>
 #include <taxel/drivers/dsa_protocol.hpp>
 #include <taxel/drivers/dsacon_emulator.hpp>
 #include <taxel/sim.hpp>
@@ -111,17 +112,7 @@ inline void write_poses_csv(const std::string& path, const std::map<std::uint32_
 /// Fixed pad poses from the matrix info (centre in mm, angles in rad, rotation
 /// Rz * Ry * Rx): where the controller says each matrix sits in the hand frame.
 inline Poses static_poses(const std::vector<dsa::MatrixInfo>& matrices) {
-  Poses out;
-  for (const auto& m : matrices) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = (Eigen::AngleAxisd(m.theta[2], taxel::Vec3d::UnitZ()) *
-                  Eigen::AngleAxisd(m.theta[1], taxel::Vec3d::UnitY()) *
-                  Eigen::AngleAxisd(m.theta[0], taxel::Vec3d::UnitX()))
-                     .toRotationMatrix();
-    T.translation() = 1e-3 * taxel::Vec3d(m.center[0], m.center[1], m.center[2]);
-    out.push_back(T);
-  }
-  return out;
+  return taxel::drivers::static_matrix_poses(matrices);
 }
 
 /// A simulated three-finger hand (two 14x6 pads per finger) grasping a shape: the frames the

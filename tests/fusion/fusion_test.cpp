@@ -9,6 +9,7 @@
 #include <random>
 #include <taxel/fusion.hpp>
 #include <taxel/index.hpp>
+#include <taxel/io/ply.hpp>
 #include <taxel/sim.hpp>
 #include <vector>
 
@@ -548,4 +549,69 @@ TEST_CASE("Surfel fits the curvature of a cylinder patch", "[fusion]") {
   CHECK(h[0] + h[2] == Approx(1 / R).epsilon(0.03));
   CHECK(std::abs(h[0] * h[2] - h[1] * h[1]) < 0.05 / (R * R));
   CHECK(std::abs(surfel.mean(s).head<2>().norm() - R) < 5e-6);
+}
+
+TEST_CASE("to_point_cloud: full covariances, normals and confidence filters",
+          "[fusion][confidence]") {
+  namespace tf = taxel::fusion;
+  taxel::sim::ExplorationConfig cfg;
+  cfg.seed = 9;
+  const auto contacts =
+      taxel::sim::explore_palpation(taxel::sim::Sphere(0.03), cfg, {.touches = 6}).contacts();
+  tf::ContactCloud<tf::Surfel<double>> cloud({.association_radius = 4e-3});
+  cloud.insert(std::span<const taxel::Contact<double>>(contacts));
+  REQUIRE(cloud.size() > 10);
+  const auto all = cloud.to_point_cloud();
+  REQUIRE(all.size() == cloud.size());
+  REQUIRE(all.normals.size() == cloud.size());  // Surfel estimates normals
+  const char* names[6] = {"cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"};
+  const int rc[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto id = static_cast<taxel::index::PointId>(i);
+    const taxel::Mat3d c = cloud.covariance(id);
+    for (int k = 0; k < 6; ++k) {
+      CHECK(all.field(names[k])->values[i] == c(rc[k][0], rc[k][1]));
+    }
+    CHECK(all.field("observations")->values[i] == double(cloud.observations(id)));
+    CHECK(all.normals[i].norm() == Approx(1.0));
+    // The normal of a sphere point points away from the centre.
+    CHECK(all.normals[i].dot(all.points[i].normalized()) > 0.9);
+  }
+  // Filters against brute force with Eigen's eigen-solver.
+  for (const std::uint32_t min_obs : {1u, 5u, 50u}) {
+    for (const double max_sigma : {1e-4, 3e-4, 1e-3, std::numeric_limits<double>::infinity()}) {
+      const auto kept = cloud.to_point_cloud({min_obs, max_sigma});
+      std::size_t expected = 0;
+      for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const auto id = static_cast<taxel::index::PointId>(i);
+        const double top =
+            Eigen::SelfAdjointEigenSolver<taxel::Mat3d>(cloud.covariance(id)).eigenvalues()(2);
+        const bool pass = cloud.observations(id) >= min_obs && std::sqrt(top) <= max_sigma;
+        CHECK(cloud.confident(id, {min_obs, max_sigma}) == pass);
+        if (pass) {
+          REQUIRE(expected < kept.size());
+          CHECK(kept.points[expected] == all.points[i]);
+          ++expected;
+        }
+      }
+      CHECK(kept.size() == expected);
+    }
+  }
+  CHECK(cloud.to_point_cloud({1, 0.0}).size() == 0);
+  CHECK_THROWS_AS(cloud.to_point_cloud({1, -1.0}), std::invalid_argument);
+  CHECK_THROWS_AS(cloud.to_point_cloud({1, std::nan("")}), std::invalid_argument);
+  // A single coarse contact does not pass a support filter, however tight its covariance.
+  tf::ContactCloud<tf::Kalman<double>> one;
+  taxel::Contact<double> c;
+  c.position = taxel::Vec3d(0.1, 0, 0);
+  c.covariance = 1e-10 * taxel::Mat3d::Identity();
+  one.insert(c);
+  CHECK(one.to_point_cloud().normals.empty());  // Kalman keeps no normal
+  CHECK(one.to_point_cloud({3}).size() == 0);
+  CHECK(one.to_point_cloud({1, 1e-4}).size() == 1);
+  // The covariance fields survive a PLY round trip.
+  const std::string ply = taxel::io::encode_ply(all, taxel::io::PlyFormat::binary_little_endian);
+  const auto back = taxel::io::parse_ply(ply, "cloud.ply");
+  for (int k = 0; k < 6; ++k)
+    CHECK(back.cloud.field(names[k])->values == all.field(names[k])->values);
 }

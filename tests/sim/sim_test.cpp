@@ -124,6 +124,93 @@ TEST_CASE("Cone: exact closest point, signed distance, normals, uniform sampling
   CHECK_THROWS_AS(taxel::sim::Cone(0.0, 1.0), std::invalid_argument);
 }
 
+namespace {
+// Brute force against dense area-uniform samples: no sample nearer than the exact distance, the
+// nearest within the sampling spacing; the normal points from the closest point to the query.
+template <class Sh>
+void check_against_samples(const Sh& shape, double extent, double spacing) {
+  const auto samples = taxel::sim::sample_surface(shape, 200000, 5);
+  for (const auto& p : samples.points) REQUIRE(std::abs(shape.signed_distance(p)) < 1e-12);
+  for (std::size_t i = 0; i < samples.size(); i += 997) {  // sampled normals are the shape's
+    REQUIRE((shape.normal(samples.points[i]) - samples.normals[i]).norm() < 1e-9);
+  }
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-extent, extent);
+  for (int q = 0; q < 300; ++q) {
+    const taxel::Vec3d p(u(rng), u(rng), u(rng));
+    const double d = shape.signed_distance(p);
+    const taxel::Vec3d c = shape.closest_point(p);
+    REQUIRE(std::abs(shape.signed_distance(c)) < 1e-12);
+    REQUIRE((p - c).norm() == Approx(std::abs(d)).margin(1e-12));
+    double nearest = 1e9;
+    for (const auto& s : samples.points) nearest = std::min(nearest, (s - p).norm());
+    REQUIRE(nearest >= std::abs(d) - 1e-12);
+    REQUIRE(nearest <= std::abs(d) + spacing);
+    const taxel::Vec3d n = shape.normal(p);
+    REQUIRE(n.norm() == Approx(1.0).epsilon(1e-12));
+    if (std::abs(d) > 1e-9) REQUIRE(n.dot(p - c) * (d > 0 ? 1.0 : -1.0) > 0.0);
+  }
+}
+}  // namespace
+
+TEST_CASE("Ellipsoid: closest point against brute force, area, uniform sampling", "[sim][shapes]") {
+  const taxel::sim::Ellipsoid el(taxel::Vec3d(0.05, 0.035, 0.025));
+  check_shape_laws(el, 0.05);
+  check_against_samples(el, 0.07, 1.5e-3);
+  // Closed forms: on the axes, and a point on a symmetry plane inside (the mirror case).
+  CHECK(el.signed_distance(taxel::Vec3d(0.08, 0, 0)) == Approx(0.03));
+  CHECK(el.signed_distance(taxel::Vec3d(0, 0, 0)) == Approx(-0.025));
+  CHECK(el.closest_point(taxel::Vec3d(0, 0, 0.01)).z() == Approx(0.025));
+  // The sphere as a special case, and the area against the sphere's and a prolate spheroid's
+  // closed form 2 pi a^2 (1 + c / (a e) asin e), e^2 = 1 - a^2 / c^2.
+  CHECK(taxel::sim::surface_area(taxel::sim::Ellipsoid(taxel::Vec3d(0.02, 0.02, 0.02))) ==
+        Approx(4 * 3.14159265358979 * 4e-4).epsilon(1e-6));
+  const double a = 0.02, c = 0.05, e = std::sqrt(1 - a * a / (c * c));
+  CHECK(taxel::sim::surface_area(taxel::sim::Ellipsoid(taxel::Vec3d(a, a, c))) ==
+        Approx(2 * 3.14159265358979 * a * a * (1 + c / (a * e) * std::asin(e))).epsilon(1e-6));
+  // Area-uniform: the fraction of samples with |z| > c / 2 against the area quadrature of that
+  // band, done by brute force over a fine (u, v) grid of the same ellipsoid.
+  const auto samples = taxel::sim::sample_surface(el, 100000, 9);
+  std::size_t high = 0;
+  for (const auto& p : samples.points) high += std::abs(p.z()) > 0.0125 ? 1 : 0;
+  double band = 0.0, total = 0.0;
+  const int n = 400;
+  for (int i = 0; i < n; ++i) {
+    const double u = (i + 0.5) * 3.14159265358979 / n;
+    for (int j = 0; j < n; ++j) {
+      const double v = (j + 0.5) * 2 * 3.14159265358979 / n;
+      const taxel::Vec3d du(0.05 * std::cos(u) * std::cos(v), 0.035 * std::cos(u) * std::sin(v),
+                            -0.025 * std::sin(u));
+      const taxel::Vec3d dv(-0.05 * std::sin(u) * std::sin(v), 0.035 * std::sin(u) * std::cos(v),
+                            0.0);
+      const double dA = du.cross(dv).norm();
+      total += dA;
+      band += std::abs(0.025 * std::cos(u)) > 0.0125 ? dA : 0.0;
+    }
+  }
+  CHECK(double(high) / double(samples.size()) == Approx(band / total).margin(0.006));
+  CHECK_THROWS_AS(taxel::sim::Ellipsoid(taxel::Vec3d(0.01, 0, 0.01)), std::invalid_argument);
+}
+
+TEST_CASE("Torus: closest point against brute force, area, uniform sampling", "[sim][shapes]") {
+  const taxel::sim::Torus torus(0.04, 0.015);
+  check_shape_laws(torus, 0.05);
+  check_against_samples(torus, 0.06, 1.5e-3);
+  CHECK(torus.signed_distance(taxel::Vec3d(0, 0, 0)) == Approx(0.025));
+  CHECK(torus.signed_distance(taxel::Vec3d(0.04, 0, 0)) == Approx(-0.015));
+  CHECK(torus.signed_distance(taxel::Vec3d(0, 0.04, 0.02)) == Approx(0.005));
+  CHECK(taxel::sim::surface_area(torus) == Approx(4 * 9.8696044010894 * 0.04 * 0.015));
+  // Area-uniform: the outer half (distance from the axis > R) holds (pi R + 2 r) / (2 pi R) of
+  // the area (integral of R + r cos theta over |theta| < pi / 2).
+  const auto samples = taxel::sim::sample_surface(torus, 100000, 9);
+  std::size_t outer = 0;
+  for (const auto& p : samples.points) outer += std::hypot(p.x(), p.y()) > 0.04 ? 1 : 0;
+  CHECK(
+      double(outer) / double(samples.size()) ==
+      Approx((3.14159265358979 * 0.04 + 2 * 0.015) / (2 * 3.14159265358979 * 0.04)).margin(0.006));
+  CHECK_THROWS_AS(taxel::sim::Torus(0.01, 0.02), std::invalid_argument);
+}
+
 TEST_CASE(
     "TriangleMesh: exact on its own surface, within the chord error of the shape it "
     "approximates",

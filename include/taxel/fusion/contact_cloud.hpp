@@ -2,6 +2,9 @@
 // ContactCloud: a compact cloud of fused contact points (Meier et al. 2011, Sec. II).
 #pragma once
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
@@ -180,27 +183,63 @@ class ContactCloud {
   /// The configuration in use.
   [[nodiscard]] const Config& config() const noexcept { return config_; }
 
-  /// The points as a PointCloud with fields "observations", "covariance_trace" [m^2] and
-  /// "last_time" [s].
-  [[nodiscard]] PointCloud<Scalar> to_point_cloud() const {
+  /// Which points count as confident surface points (`to_point_cloud`, `confident`).
+  struct PointFilter {
+    /// Fewest contacts fused into a point. A point seeded by a single contact, however fine, may
+    /// be a noise tail; 3 or more is a sensible floor for a cloud used downstream.
+    std::uint32_t min_observations = 1;
+    /// Largest standard deviation of the point's covariance, along any direction [m] (the
+    /// square root of its largest eigenvalue); infinity keeps all.
+    Scalar max_sigma = std::numeric_limits<Scalar>::infinity();
+  };
+
+  /// True when point `id` passes `filter`. Throws std::invalid_argument for a NaN or negative
+  /// max_sigma.
+  [[nodiscard]] bool confident(index::PointId id, const PointFilter& filter) const {
+    TAXEL_ASSERT(id < size(), "ContactCloud::confident: id out of range");
+    check_filter(filter);
+    return passes(points_[id], filter);
+  }
+
+  /// The points as a PointCloud, keeping those that pass `filter` (all by default), in id
+  /// order. Fields: "observations"; the covariance [m^2] as "cov_xx", "cov_xy", "cov_xz",
+  /// "cov_yy", "cov_yz", "cov_zz"; "last_time" [s]. Normals when the policy estimates them
+  /// (Surfel: the mean contact normal) and every kept point has one. Throws
+  /// std::invalid_argument for a NaN or negative max_sigma.
+  [[nodiscard]] PointCloud<Scalar> to_point_cloud(const PointFilter& filter = {}) const {
+    check_filter(filter);
     PointCloud<Scalar> out;
-    out.points.reserve(size());
-    std::vector<Scalar> obs, trace, time;
-    obs.reserve(size());
-    trace.reserve(size());
-    time.reserve(size());
-    for (std::size_t i = 0; i < size(); ++i) {
-      out.points.push_back(policy_.mean(points_[i].state));
-      obs.push_back(static_cast<Scalar>(points_[i].meta.observations));
-      trace.push_back(policy_.covariance(points_[i].state).trace());
-      time.push_back(static_cast<Scalar>(points_[i].meta.last_time));
+    std::vector<Scalar> obs, time;
+    std::array<std::vector<Scalar>, 6> cov;
+    std::vector<Vec3<Scalar>> normals;
+    constexpr bool kNormals = requires(const F& f, const State& st) {
+      { f.normal(st) } -> std::convertible_to<Vec3<Scalar>>;
+    };
+    bool all_normals = kNormals;
+    for (const Point& p : points_) {
+      if (!passes(p, filter)) continue;
+      out.points.push_back(policy_.mean(p.state));
+      obs.push_back(static_cast<Scalar>(p.meta.observations));
+      const Mat3<Scalar> c = policy_.covariance(p.state);
+      const std::array<Scalar, 6> upper{c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2)};
+      for (std::size_t k = 0; k < 6; ++k) cov[k].push_back(upper[k]);
+      time.push_back(static_cast<Scalar>(p.meta.last_time));
+      if constexpr (kNormals) {
+        if (all_normals) {
+          const Vec3<Scalar> n = policy_.normal(p.state);
+          all_normals = n.squaredNorm() > Scalar(0.5);
+          normals.push_back(n);
+        }
+      }
     }
+    if (all_normals && !out.points.empty()) out.normals = std::move(normals);
     out.fields.push_back({"observations", std::move(obs)});
-    out.fields.push_back({"covariance_trace", std::move(trace)});
+    constexpr std::array<const char*, 6> kCov{"cov_xx", "cov_xy", "cov_xz",
+                                              "cov_yy", "cov_yz", "cov_zz"};
+    for (std::size_t k = 0; k < 6; ++k) out.fields.push_back({kCov[k], std::move(cov[k])});
     out.fields.push_back({"last_time", std::move(time)});
     return out;
   }
-
   /// Removes every point.
   void clear() {
     points_.clear();
@@ -252,6 +291,31 @@ class ContactCloud {
     Meta meta;
   };
   std::vector<Point> points_;
+
+  static void check_filter(const PointFilter& filter) {
+    if (!(filter.max_sigma >= Scalar(0))) {
+      throw std::invalid_argument("ContactCloud::PointFilter::max_sigma must be >= 0 [m], got " +
+                                  std::to_string(filter.max_sigma));
+    }
+  }
+  bool passes(const Point& p, const PointFilter& filter) const {
+    if (p.meta.observations < filter.min_observations) return false;
+    if (filter.max_sigma == std::numeric_limits<Scalar>::infinity()) return true;
+    return largest_eigenvalue(policy_.covariance(p.state)) <= filter.max_sigma * filter.max_sigma;
+  }
+  // Largest eigenvalue of a symmetric 3x3 matrix, in closed form (the trigonometric solution of
+  // the characteristic cubic; Smith, Comm. ACM 4(4), 1961).
+  static Scalar largest_eigenvalue(const Mat3<Scalar>& a) {
+    const Scalar p1 = a(0, 1) * a(0, 1) + a(0, 2) * a(0, 2) + a(1, 2) * a(1, 2);
+    const Scalar q = a.trace() / Scalar(3);
+    if (p1 == Scalar(0)) return std::max({a(0, 0), a(1, 1), a(2, 2)});
+    const Scalar p2 = (a(0, 0) - q) * (a(0, 0) - q) + (a(1, 1) - q) * (a(1, 1) - q) +
+                      (a(2, 2) - q) * (a(2, 2) - q) + Scalar(2) * p1;
+    const Scalar p = std::sqrt(p2 / Scalar(6));
+    const Mat3<Scalar> b = (a - q * Mat3<Scalar>::Identity()) / p;
+    const Scalar r = std::clamp(b.determinant() / Scalar(2), Scalar(-1), Scalar(1));
+    return q + Scalar(2) * p * std::cos(std::acos(r) / Scalar(3));
+  }
 };
 
 }  // namespace taxel::fusion

@@ -2,6 +2,7 @@
 // Surfel: a Kalman point that knows it sits on a curved surface.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -30,12 +31,14 @@ namespace taxel::fusion {
 ///    taking the contact normal to it), so all tight planes are parallel and the Kalman mean
 ///    is an information-weighted average in that frame, whose only bias is the sag;
 ///  - its sideways offset u (in the frame) and its normal's slope s (sideways part over
-///    normal part, which is H u + const on a quadric) are accumulated, 12 sums in all;
+///    normal part, which is H u + const on a quadric) are accumulated, 13 sums in all;
 ///  - the curvature H is the symmetric part of the least-squares fit of s on u, with a ridge
 ///    prior H ~ N(0, curvature_prior^2) against normal noise `normal_sigma`, so that few or
 ///    collinear contacts give H near 0;
-///  - the mean is the Kalman mean moved outward along n0 by the sag tr(H M) / 2, M the
-///    second moment of the accumulated offsets about the Kalman mean.
+///  - the mean is the quadric's point above the weighted centroid of the offsets: the
+///    weighted mean height plus the sag tr(H C_uu) / 2 (C_uu the weighted covariance of the
+///    offsets), the sag bounded by half the offsets' spread so that a noisy fit cannot throw
+///    the point off the surface.
 /// Contacts without a normal, or turned further than `max_normal_angle` (across an edge),
 /// update the Kalman state unchanged and do not enter the sums. On a plane with exact normals
 /// (all equal) the rotation is the identity and H = 0: the result is exactly `Kalman`'s.
@@ -121,8 +124,10 @@ struct Surfel {
     const Vec3<S> t2 = s.n0.cross(s.t1);
     const Vec3<S> d = c.position - s.origin;
     const S ux = s.t1.dot(d), uy = t2.dot(d);
+    // A slope is tan of the normal's angle to n0: beyond max_normal_angle it is no curvature
+    // datum but an edge or an outlier, and would dominate the fit.
     const S nz = nc.dot(s.n0);
-    if (!(nz > S(0))) return true;
+    if (!(nz >= cos_max_)) return true;
     const S sx = s.t1.dot(nc) / nz, sy = t2.dot(nc) / nz;
     // Weighted like the Kalman average along the normal: by the contact's information there.
     const S w = S(1) / nm.dot(turned.covariance * nm);
@@ -145,8 +150,19 @@ struct Surfel {
     // sag tr(H C_uu) / 2.
     const S cxx = s.suu[0] * inv - ux * ux, cxy = s.suu[1] * inv - ux * uy;
     const S cyy = s.suu[2] * inv - uy * uy;
-    const S z = s.sz * inv + S(0.5) * (h[0] * cxx + S(2) * h[1] * cxy + h[2] * cyy);
+    // The sag is bounded by half the lateral spread (|H| sigma_u <= 1: a height field whose
+    // slope over one standard deviation of the offsets stays below 45 degrees); beyond that the
+    // fit is noise, not a surface.
+    const S sag = S(0.5) * (h[0] * cxx + S(2) * h[1] * cxy + h[2] * cyy);
+    const S bound = S(0.5) * std::sqrt(std::max(cxx + cyy, S(0)));
+    const S z = s.sz * inv + std::clamp(sag, -bound, bound);
     return s.origin + ux * s.t1 + uy * s.n0.cross(s.t1) + z * s.n0;
+  }
+  /// The point's surface normal: the mean of its contacts' normals (unit), or zero when no
+  /// contact had one.
+  Vec3<S> normal(const State& s) const noexcept {
+    const S n = s.normal_sum.norm();
+    return n > S(0) ? Vec3<S>(s.normal_sum / n) : Vec3<S>::Zero();
   }
   /// The filter covariance [m^2] (of the Kalman state; the sag term adds no variance).
   const Mat3<S>& covariance(const State& s) const noexcept { return s.kalman.covariance; }

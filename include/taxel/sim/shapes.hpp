@@ -209,6 +209,101 @@ struct Cone {
   }
 };
 
+/// Ellipsoid centred at the origin with semi-axes `semi_axes` (a, b, c) along x, y, z [m]:
+/// (x/a)^2 + (y/b)^2 + (z/c)^2 = 1. The closest point solves the Lagrange condition
+/// x_i = e_i^2 y_i / (t + e_i^2) for the largest root t of
+/// F(t) = sum_i (e_i y_i / (t + e_i^2))^2 - 1, which is convex and decreasing for
+/// t > -min e_i^2; Newton's method from the left end of the bracket
+/// [-e_min^2 + e_min |y_min|, |e o y| - e_min^2] converges monotonically (Eberly, "Distance
+/// from a point to an ellipse, an ellipsoid, or a hyperellipsoid", Geometric Tools, 2013).
+struct Ellipsoid {
+  Vec3d semi_axes{0.05, 0.035, 0.025};
+
+  /// Throws std::invalid_argument unless all semi-axes are finite and > 0.
+  explicit Ellipsoid(const Vec3d& e = Vec3d(0.05, 0.035, 0.025)) : semi_axes(e) {
+    if (!(e.array() > 0).all() || !e.allFinite()) {
+      throw std::invalid_argument("Ellipsoid: semi-axes must be finite and > 0");
+    }
+  }
+  double signed_distance(const Vec3d& p) const {
+    const double d = (p - closest_point(p)).norm();
+    return p.cwiseQuotient(semi_axes).squaredNorm() < 1.0 ? -d : d;
+  }
+  Vec3d closest_point(const Vec3d& p) const {
+    const Vec3d& e = semi_axes;
+    // Work in the first octant; a coordinate on a symmetry plane is nudged off it so that F has
+    // its pole (the far branch of the inside case picks one of two mirror-image answers).
+    const double tiny = 1e-9 * e.maxCoeff();
+    Vec3d y = p.cwiseAbs();
+    for (int i = 0; i < 3; ++i) y[i] = std::max(y[i], tiny);
+    const Vec3d e2 = e.cwiseProduct(e);
+    Eigen::Index k;
+    const double emin2 = e2.minCoeff(&k);
+    const auto F = [&](double t, double& dF) {
+      double f = -1.0;
+      dF = 0.0;
+      for (int i = 0; i < 3; ++i) {
+        const double r = e[i] * y[i] / (t + e2[i]);
+        f += r * r;
+        dF -= 2.0 * r * r / (t + e2[i]);
+      }
+      return f;
+    };
+    double t = -emin2 + e[k] * y[k];  // F(t) >= 0 here
+    for (int it = 0; it < 100; ++it) {
+      double dF = 0.0;
+      const double f = F(t, dF);
+      if (!(f > 0.0) || dF == 0.0) break;
+      const double next = t - f / dF;
+      if (!(next > t)) break;  // converged to machine precision
+      t = next;
+    }
+    Vec3d x;
+    for (int i = 0; i < 3; ++i) x[i] = e2[i] * y[i] / (t + e2[i]);
+    // Project the last rounding onto the surface along the ray from the centre.
+    x /= std::sqrt(x.cwiseQuotient(e).squaredNorm());
+    for (int i = 0; i < 3; ++i) x[i] = std::copysign(x[i], p[i]);
+    return x;
+  }
+  Vec3d normal(const Vec3d& p) const {
+    const Vec3d c = closest_point(p);
+    return c.cwiseQuotient(semi_axes.cwiseProduct(semi_axes)).normalized();
+  }
+};
+
+/// Torus around the z axis, centred at the origin: distance `major_radius` R from the axis to
+/// the tube's centre circle, tube radius `minor_radius` r < R [m]. Closed-form closest point: the
+/// nearest point of the centre circle, then r towards the query.
+struct Torus {
+  double major_radius = 0.04;
+  double minor_radius = 0.015;
+
+  /// Throws std::invalid_argument unless 0 < minor_radius < major_radius, both finite.
+  explicit Torus(double R = 0.04, double r = 0.015) : major_radius(R), minor_radius(r) {
+    if (!(r > 0) || !(R > r) || !std::isfinite(R)) {
+      throw std::invalid_argument(
+          "Torus: radii must be finite with 0 < minor_radius < major_radius");
+    }
+  }
+  double signed_distance(const Vec3d& p) const { return (p - centre(p)).norm() - minor_radius; }
+  Vec3d closest_point(const Vec3d& p) const { return centre(p) + minor_radius * normal(p); }
+  Vec3d normal(const Vec3d& p) const {
+    const Vec3d c = centre(p);
+    const Vec3d d = p - c;
+    const double n = d.norm();
+    if (n > 0) return d / n;
+    return Vec3d(c.x(), c.y(), 0).normalized();  // on the centre circle: outwards
+  }
+
+ private:
+  // The nearest point of the tube's centre circle (any, on the axis).
+  Vec3d centre(const Vec3d& p) const {
+    const double r = std::hypot(p.x(), p.y());
+    const Vec3d radial = r > 0 ? Vec3d(p.x() / r, p.y() / r, 0) : Vec3d::UnitX();
+    return major_radius * radial;
+  }
+};
+
 /// A closed, consistently oriented triangle mesh (counter-clockwise seen from outside), e.g.
 /// read from PLY. Exact closest point by brute force over the triangles (O(triangles) per
 /// query: meant for models of up to a few thousand triangles); the sign of the distance comes

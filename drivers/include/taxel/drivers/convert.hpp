@@ -53,6 +53,25 @@ inline sim::SensorModel sensor_model(const dsa::MatrixInfo& m, const PadCalibrat
   return s;
 }
 
+/// The matrices' poses on the hand as the controller describes them (centre [mm] and the
+/// x-y-z Euler angles [rad] of its matrix info), as pad -> hand isometries [m]: the poses of a
+/// hand whose joints do not move, or a fallback when no kinematics are at hand.
+inline std::vector<Eigen::Isometry3d> static_matrix_poses(
+    std::span<const dsa::MatrixInfo> matrices) {
+  std::vector<Eigen::Isometry3d> out;
+  out.reserve(matrices.size());
+  for (const auto& m : matrices) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = (Eigen::AngleAxisd(m.theta[2], Vec3d::UnitZ()) *
+                  Eigen::AngleAxisd(m.theta[1], Vec3d::UnitY()) *
+                  Eigen::AngleAxisd(m.theta[0], Vec3d::UnitX()))
+                     .toRotationMatrix();
+    T.translation() = 1e-3 * Vec3d(m.center[0], m.center[1], m.center[2]);
+    out.push_back(T);
+  }
+  return out;
+}
+
 /// Appends the contacts of `frame` to `out`: matrix i at `pad_poses[i]` (pad -> world, from the
 /// hand's kinematics; the pad frame of sim/sensor.hpp). Readings below the calibration's
 /// threshold are ignored. Time: the controller clock in seconds. Returns the count appended.
