@@ -202,7 +202,7 @@ void pad_study(const char* name, const Shape& shape, bool quick, sim::ContactMod
 
 constexpr const char* kUsage =
     "usage: 02_fusion_study [--quick] [--out DIR]\n"
-    "Raw vs Average vs Kalman vs Surfel fusion of simulated explorations of five shapes: points,\n"
+    "Raw vs Average vs Kalman vs Surfel fusion of simulated explorations of seven shapes: points,\n"
     "compaction, distance to the true surface, coverage; PLY clouds and an SVG plot of error\n"
     "against contacts.\n";
 
