@@ -195,15 +195,17 @@ inline std::string encode_npy_u16(std::span<const std::size_t> shape,
   std::string dims;
   for (const std::size_t d : shape) {
     count *= d;
-    dims += std::to_string(d) + ", ";
+    if (!dims.empty()) dims.append(", ");
+    dims.append(std::to_string(d));
   }
   if (count != values.size()) {
     throw std::invalid_argument("encode_npy_u16: shape holds " + std::to_string(count) +
                                 " values, got " + std::to_string(values.size()));
   }
   // "(3, 4)" and "(5,)", as numpy writes them.
-  if (!dims.empty()) dims.resize(dims.size() - (shape.size() == 1 ? 1 : 2));
-  std::string header = "{'descr': '<u2', 'fortran_order': False, 'shape': (" + dims + "), }";
+  if (shape.size() == 1) dims.push_back(',');
+  std::string header;  // append(): GCC 12 misreports -Wstringop-overflow on operator+ here
+  header.append("{'descr': '<u2', 'fortran_order': False, 'shape': (").append(dims).append("), }");
   // Pad with spaces and a newline so that the data start at a multiple of 64 bytes.
   const std::size_t total = 10 + header.size() + 1;
   header.append((64 - total % 64) % 64, ' ');
