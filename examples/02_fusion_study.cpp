@@ -316,8 +316,8 @@ int main(int argc, char** argv) try {
               "surfel", "average", "kalman", "surfel");
   for (std::size_t k = 0; k < curve.contacts.size(); ++k) {
     std::printf("%-10.0f %9.3f | %9.3f %9.3f %9.3f | %9.3f %9.3f %9.3f\n", curve.contacts[k],
-                curve.raw[k], curve.average[k], curve.kalman[k], curve.surfel[k],
-                curve.average3[k], curve.kalman3[k], curve.surfel3[k]);
+                curve.raw[k], curve.average[k], curve.kalman[k], curve.surfel[k], curve.average3[k],
+                curve.kalman3[k], curve.surfel3[k]);
   }
   std::printf("wrote %s/*.ply and %s/error_vs_contacts.svg\n", out.c_str(), out.c_str());
   return 0;

@@ -153,9 +153,10 @@ struct Surfel {
     // The sag is bounded by half the lateral spread (|H| sigma_u <= 1: a height field whose
     // slope over one standard deviation of the offsets stays below 45 degrees); beyond that the
     // fit is noise, not a surface.
-    const S sag = S(0.5) * (h[0] * cxx + S(2) * h[1] * cxy + h[2] * cyy);
-    const S bound = S(0.5) * std::sqrt(std::max(cxx + cyy, S(0)));
-    const S z = s.sz * inv + std::clamp(sag, -bound, bound);
+    S sag = S(0.5) * (h[0] * cxx + S(2) * h[1] * cxy + h[2] * cyy);
+    const S bound2 = S(0.25) * std::max(cxx + cyy, S(0));
+    if (!(sag * sag <= bound2)) sag = std::copysign(std::sqrt(bound2), sag);  // rare: no sqrt
+    const S z = s.sz * inv + sag;
     return s.origin + ux * s.t1 + uy * s.n0.cross(s.t1) + z * s.n0;
   }
   /// The point's surface normal: the mean of its contacts' normals (unit), or zero when no

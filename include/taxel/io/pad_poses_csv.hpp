@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -50,22 +51,25 @@ inline std::vector<PadPose> parse_pad_poses_csv(std::string_view text,
   if (lines.line_number() == 0 || blank_or_comment(line)) {
     throw IoError(source, "empty: expected a header such as frame,pad,x,y,z,qw,qx,qy,qz");
   }
-  std::map<std::string, std::size_t, std::less<>> column;
-  {
+  // Calls cell(k, text) for the comma-separated, blank-trimmed cells of a line, k from 0.
+  const auto split = [](std::string_view row, const auto& cell) {
     std::size_t k = 0, start = 0;
     for (;;) {
-      const std::size_t comma = line.find(',', start);
-      std::string_view name = line.substr(start, comma - start);
-      while (!name.empty() && name.front() == ' ') name.remove_prefix(1);
-      while (!name.empty() && name.back() == ' ') name.remove_suffix(1);
-      if (!column.emplace(std::string(name), k).second) {
-        throw IoError(source, "column '" + std::string(name) + "' appears twice", 1);
-      }
-      ++k;
-      if (comma == std::string_view::npos) break;
+      const std::size_t comma = row.find(',', start);
+      std::string_view c = row.substr(start, comma - start);
+      while (!c.empty() && c.front() == ' ') c.remove_prefix(1);
+      while (!c.empty() && c.back() == ' ') c.remove_suffix(1);
+      cell(k++, c);
+      if (comma == std::string_view::npos) return k;
       start = comma + 1;
     }
-  }
+  };
+  std::map<std::string, std::size_t, std::less<>> column;
+  split(line, [&](std::size_t k, std::string_view name) {
+    if (!column.emplace(std::string(name), k).second) {
+      throw IoError(source, "column '" + std::string(name) + "' appears twice", 1);
+    }
+  });
   const auto find = [&](std::string_view a, std::string_view b) -> std::ptrdiff_t {
     if (auto it = column.find(a); it != column.end()) return std::ptrdiff_t(it->second);
     if (auto it = column.find(b); !b.empty() && it != column.end())
@@ -86,31 +90,24 @@ inline std::vector<PadPose> parse_pad_poses_csv(std::string_view text,
   }
   const std::size_t width = column.size();
   std::vector<PadPose> out;
-  std::map<std::pair<std::size_t, std::size_t>, bool> seen;
+  std::set<std::pair<std::size_t, std::size_t>> seen;
   std::map<double, std::size_t> frame_of_time;  // drivers' files: time_ms -> frame
   std::vector<double> cells(width);
   while (lines.next(line)) {
     if (blank_or_comment(line)) continue;
     const auto n = lines.line_number();
-    std::size_t k = 0, start = 0;
-    for (;;) {
-      const std::size_t comma = line.find(',', start);
-      std::string_view cell = line.substr(start, comma - start);
-      while (!cell.empty() && cell.front() == ' ') cell.remove_prefix(1);
-      while (!cell.empty() && cell.back() == ' ') cell.remove_suffix(1);
-      if (k >= width) throw IoError(source, "more cells than header columns", n);
+    const std::size_t k = split(line, [&](std::size_t i, std::string_view cell) {
+      if (i >= width) throw IoError(source, "more cells than header columns", n);
       double v = 0.0;
       const auto r = std::from_chars(cell.data(), cell.data() + cell.size(), v);
       if (r.ec != std::errc() || r.ptr != cell.data() + cell.size() || !std::isfinite(v)) {
         throw IoError(source,
-                      "column " + std::to_string(k + 1) + ": '" + std::string(cell) +
+                      "column " + std::to_string(i + 1) + ": '" + std::string(cell) +
                           "' is not a finite number",
                       n);
       }
-      cells[k++] = v;
-      if (comma == std::string_view::npos) break;
-      start = comma + 1;
-    }
+      cells[i] = v;
+    });
     if (k != width) {
       throw IoError(source, std::to_string(k) + " cells, the header has " + std::to_string(width),
                     n);
@@ -144,7 +141,7 @@ inline std::vector<PadPose> parse_pad_poses_csv(std::string_view text,
     p.pose.linear() = q.toRotationMatrix();
     p.pose.translation() = Vec3d(cells[std::size_t(c_val[0])], cells[std::size_t(c_val[1])],
                                  cells[std::size_t(c_val[2])]);
-    if (!seen.emplace(std::pair(p.frame, p.pad), true).second) {
+    if (!seen.emplace(p.frame, p.pad).second) {
       throw IoError(source,
                     "frame " + std::to_string(p.frame) + ", pad " + std::to_string(p.pad) +
                         " has a pose already",
