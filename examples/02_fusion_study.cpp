@@ -209,6 +209,7 @@ constexpr const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) try {
+  taxel_cli::check_stdout_at_exit("02_fusion_study");
   const taxel_cli::StudyOptions opt =
       taxel_cli::parse_study_options("02_fusion_study", kUsage, "fusion-study", argc, argv);
   const bool quick = opt.quick;

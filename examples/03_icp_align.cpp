@@ -55,6 +55,7 @@ constexpr const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) try {
+  taxel_cli::check_stdout_at_exit("03_icp_align");
   const taxel_cli::StudyOptions opt =
       taxel_cli::parse_study_options("03_icp_align", kUsage, "icp-align", argc, argv);
   const bool quick = opt.quick;

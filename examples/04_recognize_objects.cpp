@@ -47,6 +47,7 @@ constexpr const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) try {
+  taxel_cli::check_stdout_at_exit("04_recognize_objects");
   int trials = 5;
   const taxel_cli::StudyOptions opt =
       taxel_cli::parse_study_options("04_recognize_objects", kUsage, "recognize-objects", argc,

@@ -222,6 +222,7 @@ void write_picture(const std::filesystem::path& stem, const taxel::io::RgbImage&
 }  // namespace
 
 int main(int argc, char** argv) try {
+  taxel_cli::check_stdout_at_exit("06_recognition_study");
   const Options opt = parse(argc, argv);
   const auto start = Clock::now();
   const std::filesystem::path out(opt.out);

@@ -3,14 +3,34 @@
 // an exit code, option values, strictly parsed numbers, JSON string escaping.
 #pragma once
 
+#include <cerrno>
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <system_error>
 
 namespace taxel_cli {
+
+/// Makes a lost write to standard output an error, as a lost file write is: at exit (after
+/// `return` from main or std::exit), flushes standard output and, when any write to it failed
+/// (a full disk, /dev/full, a closed descriptor), prints "<tool>: cannot write standard output:
+/// <reason>" and ends the process with exit code 1. Call once, first thing in main.
+inline void check_stdout_at_exit(const char* tool) {
+  static const char* name = "taxel";
+  name = tool;
+  std::atexit([] {
+    errno = 0;
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0) {
+      const int err = errno;
+      std::fprintf(stderr, "%s: cannot write standard output: %s\n", name,
+                   err != 0 ? std::strerror(err) : "a write failed");
+      std::_Exit(1);
+    }
+  });
+}
 
 /// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).
 class Args {

@@ -30,6 +30,8 @@
 #include "../drivers/examples/device_cli.hpp"
 #endif
 
+#include "cli.hpp"
+
 namespace {
 
 using namespace taxel;
@@ -468,6 +470,7 @@ void session_section(const fs::path& out, Page& page) {
 }  // namespace
 
 int main(int argc, char** argv) try {
+  taxel_cli::check_stdout_at_exit("taxel-demo");
   bool quick = false;
   fs::path out = "taxel-demo-output";
   for (int i = 1; i < argc; ++i) {

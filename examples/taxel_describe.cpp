@@ -56,10 +56,12 @@ struct Options {
   std::vector<std::string> inputs;
 };
 
-[[noreturn]] void die(const std::string& why) {
+// Bad options exit 2, bad or unwritable data 1; nothing has been written yet either way.
+[[noreturn]] void die(const std::string& why, int code = 2) {
   std::fprintf(stderr, "taxel-describe: %s\n", why.c_str());
-  std::exit(2);
+  std::exit(code);
 }
+[[noreturn]] void bad_data(const std::string& why) { die(why, 1); }
 
 Options parse(int argc, char** argv) {
   taxel_cli::Args args("taxel-describe", argc, argv);
@@ -137,8 +139,8 @@ std::vector<int> read_labels(const std::string& path) {
     int v = 0;
     const auto res = std::from_chars(token.data(), token.data() + token.size(), v);
     if (res.ec != std::errc() || res.ptr != token.data() + token.size()) {
-      die(path + ":" + std::to_string(line_no) + ": '" + std::string(token.substr(0, 20)) +
-          "' is not an integer label");
+      bad_data(path + ":" + std::to_string(line_no) + ": '" + std::string(token.substr(0, 20)) +
+               "' is not an integer label");
     }
     labels.push_back(v);
   }
@@ -146,7 +148,7 @@ std::vector<int> read_labels(const std::string& path) {
 }
 
 // --format libsvm: every frame's features with its label.
-int write_libsvm(const Options& opt, std::FILE* out) {
+std::string describe_libsvm(const Options& opt) {
   const std::vector<int> labels = read_labels(opt.labels);
   taxel::learn::Dataset d;
   std::vector<Eigen::VectorXd> rows;
@@ -156,48 +158,44 @@ int write_libsvm(const Options& opt, std::FILE* out) {
     for (Eigen::Index f = 0; f < stack.frames; ++f) {
       const ti::Recognition& r = rec.recognize(stack.frame(f));
       if (!r.ok()) {
-        die(path + " frame " + std::to_string(f) + ": " + std::string(taxel::to_string(r.status)) +
-            ": " + r.message);
+        bad_data(path + " frame " + std::to_string(f) + ": " +
+                 std::string(taxel::to_string(r.status)) + ": " + r.message);
       }
       rows.push_back(opt.hybrid ? r.hybrid : r.regional);
     }
   }
   if (labels.size() != rows.size()) {
-    die(opt.labels + " has " + std::to_string(labels.size()) + " labels for " +
-        std::to_string(rows.size()) + " frames");
+    bad_data(opt.labels + " has " + std::to_string(labels.size()) + " labels for " +
+             std::to_string(rows.size()) + " frames");
   }
   d.x.resize(static_cast<Eigen::Index>(rows.size()), rows.empty() ? 0 : rows.front().size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (rows[i].size() != d.x.cols()) die("the input images differ in size");
+    if (rows[i].size() != d.x.cols()) bad_data("the input images differ in size");
     d.x.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
   }
   d.y = labels;
-  const std::string text = taxel::io::encode_libsvm(d.view());
-  std::fwrite(text.data(), 1, text.size(), out);
-  if (out != stdout && std::fclose(out) != 0) die("cannot write " + opt.output);
-  return 0;
+  return taxel::io::encode_libsvm(d.view());
 }
 
 }  // namespace
 
 int main(int argc, char** argv) try {
+  taxel_cli::check_stdout_at_exit("taxel-describe");
   const Options opt = parse(argc, argv);
-  std::FILE* out = stdout;
-  if (!opt.output.empty()) {
-    out = std::fopen(opt.output.c_str(), "w");
-    if (out == nullptr) die("cannot open " + opt.output + " for writing");
-  }
-  if (opt.libsvm) return write_libsvm(opt, out);
-  if (!opt.json) {
-    std::string header = "file,frame,status,edged,Gm";
-    for (const auto name : ti::kEdgeFeatureNames) header += "," + std::string(name);
-    for (const char* name : kExtra) header += std::string(",") + name;
-    std::fprintf(out, "%s%s\n", header.c_str(), opt.hybrid ? ",hybrid..." : "");
+  // The whole output is built first and written once: a failure leaves no partial output.
+  std::string out;
+  if (opt.libsvm) {
+    out = describe_libsvm(opt);
+  } else if (!opt.json) {
+    out = "file,frame,status,edged,Gm";
+    for (const auto name : ti::kEdgeFeatureNames) out += "," + std::string(name);
+    for (const char* name : kExtra) out += std::string(",") + name;
+    out += opt.hybrid ? ",hybrid...\n" : "\n";
   } else {
-    std::fputs("[\n", out);
+    out = "[\n";
   }
   bool first = true;
-  for (const std::string& path : opt.inputs) {
+  for (const std::string& path : opt.libsvm ? std::vector<std::string>{} : opt.inputs) {
     const taxel::io::ImageStack stack = taxel::io::read_image(path);
     ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg, ti::GradientThreshold{opt.threshold});
     ti::RegionAnalyzer props({}, stack.rows, stack.cols);
@@ -218,7 +216,7 @@ int main(int argc, char** argv) try {
         if (opt.hybrid) {
           for (Eigen::Index i = 0; i < r.hybrid.size(); ++i) line += "," + fmt(r.hybrid(i));
         }
-        std::fprintf(out, "%s\n", line.c_str());
+        out.append(line).append("\n");
         continue;
       }
       std::string obj = first ? "  {" : ",\n  {";
@@ -243,11 +241,15 @@ int main(int argc, char** argv) try {
         obj += "]";
       }
       obj += "}";
-      std::fputs(obj.c_str(), out);
+      out += obj;
     }
   }
-  if (opt.json) std::fputs("\n]\n", out);
-  if (out != stdout && std::fclose(out) != 0) die("cannot write " + opt.output);
+  if (opt.json && !opt.libsvm) out += "\n]\n";
+  if (opt.output.empty()) {
+    std::fwrite(out.data(), 1, out.size(), stdout);  // checked at exit
+  } else {
+    taxel::io::write_file(opt.output, out);
+  }
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "taxel-describe: %s\n", e.what());

@@ -158,8 +158,9 @@ int with_index(const Options& o, typename Policy::Config pc,
 // The contacts of a recorded DSACON32m session: each frame's matrices at the poses of the frame's
 // time stamp in POSES.csv (as taxel-record --poses writes them), else at the controller's static
 // matrix poses. Throws on a malformed file or a replay that fails.
-void session_contacts(const Options& o, const taxel::sensor::ContactOptions& copt,
-                      std::vector<taxel::Contact<double>>& out) {
+// Returns why the replay fell short of the whole recording ("" when it did not).
+std::string session_contacts(const Options& o, const taxel::sensor::ContactOptions& copt,
+                             std::vector<taxel::Contact<double>>& out) {
   namespace td = taxel::drivers;
   std::map<std::uint32_t, std::vector<Eigen::Isometry3d>> by_time;
   if (!o.poses.empty()) {
@@ -170,9 +171,16 @@ void session_contacts(const Options& o, const taxel::sensor::ContactOptions& cop
       v[p.pad] = p.pose;
     }
   }
-  td::DsaconDevice dev(td::ReplayTransport::from_file(o.session),
+  td::SessionPrefix file = td::read_session_prefix(o.session);
+  if (file.chunks.empty() && !file.error.empty()) throw td::SessionError(file.error);
+  td::DsaconDevice dev(td::ReplayTransport(std::move(file.chunks)),
                        {.frame_timeout = td::Timeout(50)});
-  dev.open();
+  try {
+    dev.open();
+  } catch (const std::exception& e) {  // the damage may lie in the handshake itself
+    if (file.error.empty()) throw;
+    throw std::runtime_error(std::string(e.what()) + "; " + file.error);
+  }
   const std::vector<Eigen::Isometry3d> fixed = td::static_matrix_poses(dev.matrices());
   td::PadCalibration cal;
   cal.full_scale_depth = o.model.full_scale_depth;
@@ -189,14 +197,19 @@ void session_contacts(const Options& o, const taxel::sensor::ContactOptions& cop
     posed += have ? 1 : 0;
     td::frame_contacts(*f, dev.matrices(), have ? it->second : fixed, out, copt.mode, cal, copt);
   }
+  // Checked before close(), whose stop command the recording may not hold.
+  const std::string shortfall =
+      td::replay_shortfall(dev.transport(), dev.unparsed_bytes(), file.error);
   dev.close();
   std::printf("session %zu frames (with poses %zu) of %zu matrices\n", frames, posed,
               dev.matrices().size());
+  return shortfall;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("taxel-fuse");
   taxel_cli::Args args("taxel-fuse", argc, argv);
   constexpr double kInf = std::numeric_limits<double>::infinity();
   Options o;
@@ -274,6 +287,7 @@ int main(int argc, char** argv) {
   taxel::sensor::ContactOptions copt;
   copt.mode =
       o.per_pad ? taxel::sensor::ContactMode::per_pad : taxel::sensor::ContactMode::per_tactel;
+  std::string shortfall;  // a session replay that ended early: the output is kept, exit 1
   try {
     if (from_readings) {
       auto stack = taxel::sensor::ReadingStack::from_npy(taxel::io::read_npy_u16(o.readings));
@@ -286,7 +300,11 @@ int main(int argc, char** argv) {
       std::printf("readings %zu frames x %zu pads of %zu x %zu\npad frames %zu (touching %zu)\n",
                   stack.frames, stack.pads, stack.rows, stack.cols, r.pad_frames, r.touching);
     } else if (from_session) {
-      session_contacts(o, copt, contacts);
+      shortfall = session_contacts(o, copt, contacts);
+      if (!shortfall.empty()) {
+        std::fprintf(stderr, "taxel-fuse: %s: %s; fusing the frames before it (exit 1)\n",
+                     o.session.c_str(), shortfall.c_str());
+      }
     } else {
       contacts = taxel::io::read_contacts_csv(o.files[0]);
     }
@@ -295,13 +313,20 @@ int main(int argc, char** argv) {
   }
   namespace tf = taxel::fusion;
   try {
-    if (o.policy == "raw") return with_index<tf::Raw<double>>(o, {}, contacts, args);
-    if (o.policy == "average") return with_index<tf::Average<double>>(o, {}, contacts, args);
+    int code = 0;
     tf::Kalman<double>::Config kc;
     kc.process_noise = o.process_noise;
     if (o.gate != 0.0) kc.gate_chi2 = o.gate;
-    if (o.policy == "kalman") return with_index<tf::Kalman<double>>(o, kc, contacts, args);
-    return with_index<tf::Surfel<double>>(o, {.kalman = kc}, contacts, args);
+    if (o.policy == "raw") {
+      code = with_index<tf::Raw<double>>(o, {}, contacts, args);
+    } else if (o.policy == "average") {
+      code = with_index<tf::Average<double>>(o, {}, contacts, args);
+    } else if (o.policy == "kalman") {
+      code = with_index<tf::Kalman<double>>(o, kc, contacts, args);
+    } else {
+      code = with_index<tf::Surfel<double>>(o, {.kalman = kc}, contacts, args);
+    }
+    return code == 0 && !shortfall.empty() ? 1 : code;
   } catch (const std::invalid_argument& e) {  // a configuration the cloud refuses
     args.fail(e.what());
   }

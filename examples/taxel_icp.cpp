@@ -142,6 +142,7 @@ tr::IcpResult dispatch(const Options& o, const tr::Target<double>& target,
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("taxel-icp");
   taxel_cli::Args args("taxel-icp", argc, argv);
   const Options opt = parse(args);
   taxel::io::PlyData source, target;

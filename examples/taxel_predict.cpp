@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: MIT
 // taxel-predict: applies a LIBLINEAR-format linear model to a libsvm-format data set and writes
 // one predicted label per line, with LIBLINEAR's `predict` output.
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <string>
 #include <string_view>
 #include <taxel/io.hpp>
 #include <taxel/learn.hpp>
+
+#include "cli.hpp"
 
 namespace {
 
@@ -16,6 +20,7 @@ constexpr const char* kUsage =
     R"usage(Usage: taxel-predict [options] test_file model_file output_file
 options:
 -q : quiet mode (no outputs)
+--max-values n : largest dense data set read, samples x features (default 16777216)
 -h, --help : show this help
 
 model_file is a LIBLINEAR text model (from taxel-train or LIBLINEAR's train, any classification
@@ -31,9 +36,11 @@ solver). As LIBLINEAR does, features beyond the model's nr_feature are ignored. 
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("taxel-predict");
   try {
     bool quiet = false;
     std::vector<std::string> files;
+    taxel::io::LibsvmReadOptions read_opt;
     for (int i = 1; i < argc; ++i) {
       const std::string_view a = argv[i];
       if (a == "-h" || a == "--help") {
@@ -42,6 +49,14 @@ int main(int argc, char** argv) {
       }
       if (a == "-q") {
         quiet = true;
+      } else if (a == "--max-values") {
+        const std::string_view t = i + 1 < argc ? argv[++i] : "";
+        std::uint64_t v = 0;
+        const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+        if (r.ec != std::errc{} || r.ptr != t.data() + t.size() || v == 0) {
+          fail("--max-values expects a positive integer, got '" + std::string(t) + "'");
+        }
+        read_opt.max_values = v;
       } else if (a.size() > 1 && a[0] == '-') {
         std::fprintf(stderr, "taxel-predict: unknown option %s\n%s", argv[i], kUsage);
         return 1;
@@ -54,7 +69,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     const tl::LinearSvm model = tl::LinearSvm::load(taxel::io::read_file(files[1]), files[1]);
-    tl::Dataset test = taxel::io::read_libsvm(files[0]);
+    tl::Dataset test = taxel::io::read_libsvm(files[0], read_opt);
     if (test.dims() != model.dims()) {  // LIBLINEAR ignores extra features; absent ones are 0
       tl::FeatureMatrix x = tl::FeatureMatrix::Zero(test.rows(), model.dims());
       const Eigen::Index common = std::min(test.dims(), model.dims());

@@ -41,6 +41,7 @@ Exit status: 0 when the cloud was ranked, 1 for unreadable input, 2 for bad opti
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("taxel-recognize");
   taxel_cli::Args args("taxel-recognize", argc, argv);
   const auto die = [&](const std::string& why, int code = 2) { args.fail(why, code); };
   constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -176,6 +176,7 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("taxel-simulate");
   taxel_cli::Args args("taxel-simulate", argc, argv);
   constexpr double kInf = std::numeric_limits<double>::infinity();
   Options o;

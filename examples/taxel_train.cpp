@@ -11,6 +11,8 @@
 #include <taxel/io.hpp>
 #include <taxel/learn.hpp>
 
+#include "cli.hpp"
+
 namespace {
 
 namespace tl = taxel::learn;
@@ -29,6 +31,7 @@ options:
 --seed n : seed of the coordinate permutation and of the folds (default 1)
 --grouped : with -v, keep each qid group in one fold
 --max-iter n : outer iterations per binary problem (default 1000, as LIBLINEAR 2.3)
+--max-values n : largest dense data set read, samples x features (default 16777216)
 -h, --help : show this help
 
 The model file is LIBLINEAR's text format (default: <training_set_file basename>.model in the
@@ -58,6 +61,7 @@ std::string basename(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("taxel-train");
   try {
     tl::LinearSvmConfig cfg;
     int folds = 0;
@@ -65,6 +69,7 @@ int main(int argc, char** argv) {
     bool grouped = false;
     std::string data_file;
     std::string model_file;
+    taxel::io::LibsvmReadOptions read_opt;
     for (int i = 1; i < argc; ++i) {
       const std::string_view a = argv[i];
       const auto value = [&]() -> const char* {
@@ -97,6 +102,10 @@ int main(int argc, char** argv) {
         cfg.seed = static_cast<std::uint64_t>(number(a, value()));
       } else if (a == "--max-iter") {
         cfg.max_iterations = static_cast<int>(number(a, value()));
+      } else if (a == "--max-values") {
+        const double v = number(a, value());
+        if (!(v >= 1.0 && v <= 1e18)) fail("--max-values must be in [1, 1e18]");
+        read_opt.max_values = static_cast<std::uint64_t>(v);
       } else if (a == "--grouped") {
         grouped = true;
       } else if (a.size() > 1 && a[0] == '-') {
@@ -115,7 +124,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     const tl::LinearSvm prototype(cfg);  // validates the options
-    const tl::Dataset data = taxel::io::read_libsvm(data_file);
+    const tl::Dataset data = taxel::io::read_libsvm(data_file, read_opt);
 
     if (folds > 0) {
       tl::CvOptions opt;

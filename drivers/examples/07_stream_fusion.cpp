@@ -20,6 +20,7 @@
 #include <taxel/fusion.hpp>
 #include <taxel/index.hpp>
 #include <taxel/io/ply.hpp>
+#include <type_traits>
 
 #include "../../examples/cli.hpp"
 #include "device_cli.hpp"
@@ -51,9 +52,11 @@ struct Options {
   bool per_pad = false, realtime = false;
 };
 
+// `file_error`: the malformed line that cut a replayed session short ("" for a whole file or a
+// live device).
 template <class T>
 int run(T transport, const Options& o, const std::map<std::uint32_t, cli::Poses>& pose_table,
-        const taxel_cli::Args& args) {
+        const taxel_cli::Args& args, const std::string& file_error = {}) {
   td::DsaconDevice dev(std::move(transport),
                        {.frame_timeout = td::Timeout(o.replay.empty() ? 1000 : 50)});
   taxel::fusion::ContactCloud<taxel::fusion::Kalman<double>, taxel::index::VoxelHash<double>> cloud(
@@ -63,13 +66,19 @@ int run(T transport, const Options& o, const std::map<std::uint32_t, cli::Poses>
   double fuse_seconds = 0.0;
   const long limit = o.frames >= 0 ? o.frames : o.replay.empty() ? 300 : -1;  // live: 300
   const auto t0 = std::chrono::steady_clock::now();
+  std::string shortfall;  // why a replay stopped before the end of its recording
   try {
     dev.open();
     const cli::Poses fixed = cli::static_poses(dev.matrices());
     dev.start();
     while (limit < 0 || long(frames) < limit) {
       const auto f = dev.read_frame();
-      if (!f) break;  // end of the session, or a silent device
+      if (!f) {  // the end of the session, or a silent device
+        if constexpr (std::is_same_v<T, td::ReplayTransport>) {
+          shortfall = td::replay_shortfall(dev.transport(), dev.unparsed_bytes(), file_error);
+        }
+        break;
+      }
       ++frames;
       const auto it = pose_table.find(f->device_time_ms);
       const cli::Poses& poses = it != pose_table.end() ? it->second : fixed;
@@ -106,12 +115,16 @@ int run(T transport, const Options& o, const std::map<std::uint32_t, cli::Poses>
     args.fail(e.what(), 1);
   }
   std::printf("wrote %s\n", ply.c_str());
+  if (!shortfall.empty()) {
+    args.fail(o.replay + ": " + shortfall + "; the cloud holds the frames before it", 1);
+  }
   return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("07_stream_fusion");
   taxel_cli::Args args("07_stream_fusion", argc, argv);
   Options o;
   std::string_view a;
@@ -148,8 +161,12 @@ int main(int argc, char** argv) {
   try {
     std::map<std::uint32_t, cli::Poses> pose_table;
     if (!o.poses.empty()) pose_table = cli::read_poses_csv(o.poses);
-    if (!o.replay.empty())
-      return run(td::ReplayTransport::from_file(o.replay, o.realtime), o, pose_table, args);
+    if (!o.replay.empty()) {
+      td::SessionPrefix file = td::read_session_prefix(o.replay);
+      if (file.chunks.empty() && !file.error.empty()) throw td::SessionError(file.error);
+      return run(td::ReplayTransport(std::move(file.chunks), o.realtime), o, pose_table, args,
+                 file.error);
+    }
     if (!o.serial.empty()) return run(td::SerialTransport(o.serial), o, pose_table, args);
     const auto ids = cli::parse_pair(o.usb, 16);
     if (!ids) args.fail("--usb: '" + o.usb + "' is not of the form VID:PID (hex)");

@@ -8,7 +8,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -17,6 +16,7 @@
 #include <taxel/drivers/convert.hpp>
 #include <taxel/drivers/dsa_protocol.hpp>
 #include <taxel/drivers/dsacon_emulator.hpp>
+#include <taxel/io/file.hpp>
 #include <taxel/sim.hpp>
 #include <utility>
 #include <vector>
@@ -47,8 +47,7 @@ inline std::optional<std::pair<unsigned, unsigned>> parse_pair(const std::string
 /// `time_ms,matrix,x,y,z,qw,qx,qy,qz` (metres; unit quaternion pad -> world).
 /// Within a frame the rows run over the matrices in order, 0, 1, 2, ...
 inline std::map<std::uint32_t, Poses> read_poses_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::istringstream in(taxel::io::read_file(path));
   std::string line;
   std::size_t line_no = 1;
   if (!std::getline(in, line) || line != "time_ms,matrix,x,y,z,qw,qx,qy,qz") {
@@ -93,9 +92,9 @@ inline std::map<std::uint32_t, Poses> read_poses_csv(const std::string& path) {
   return out;
 }
 
-/// Writes poses in the format read_poses_csv reads.
+/// Writes poses in the format read_poses_csv reads, whole or not at all (taxel::io::write_file).
 inline void write_poses_csv(const std::string& path, const std::map<std::uint32_t, Poses>& poses) {
-  std::ofstream out(path);
+  std::ostringstream out;
   out << "time_ms,matrix,x,y,z,qw,qx,qy,qz\n";
   out.precision(9);
   for (const auto& [t, ps] : poses) {
@@ -106,7 +105,7 @@ inline void write_poses_csv(const std::string& path, const std::map<std::uint32_
           << q.x() << ',' << q.y() << ',' << q.z() << '\n';
     }
   }
-  if (!out) throw std::runtime_error(path + ": cannot write");
+  taxel::io::write_file(path, out.str());
 }
 
 /// Fixed pad poses from the matrix info (centre in mm, angles in rad, rotation

@@ -131,6 +131,7 @@ int emulate(const Shape& shape, const Options& o, const taxel_cli::Args& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  taxel_cli::check_stdout_at_exit("taxel-record");
   taxel_cli::Args args("taxel-record", argc, argv);
   Options o;
   std::string_view a;

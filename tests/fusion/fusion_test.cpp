@@ -330,6 +330,15 @@ TEST_CASE("ContactCloud rejects invalid contacts and stays unchanged", "[fusion]
   bad.push_back({c, taxel::ContactDefect::indefinite_covariance});
   c = contact_at<double>({0, 0, 0}, taxel::Mat3d::Zero());
   bad.push_back({c, taxel::ContactDefect::indefinite_covariance});
+  c = contact_at<double>({0, 0, 0}, R);
+  c.time = nan;
+  bad.push_back({c, taxel::ContactDefect::non_finite_time});
+  c = contact_at<double>({0, 0, 0}, R);
+  c.pressure = -inf;
+  bad.push_back({c, taxel::ContactDefect::non_finite_pressure});
+  // Beyond the voxel hash's exact range (about 6400 km for this radius), where every point
+  // would share a clamped border cell and inserts would turn quadratic.
+  bad.push_back({contact_at<double>({0, 1e7, 0}, R), taxel::ContactDefect::out_of_range});
 
   for (const auto& [contact, defect] : bad) {
     const auto r = cloud.insert(contact);

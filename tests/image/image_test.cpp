@@ -781,3 +781,17 @@ TEST_CASE("Recognizer: features, edged decision, no allocation per image", "[ima
     CHECK(g_allocations.load() - before == 0);
   }
 }
+
+TEST_CASE("Image types refuse negative and huge sizes before allocating", "[image][reliability]") {
+  using Catch::Matchers::Contains;
+  CHECK_THROWS_WITH(ti::Recognizer<>(-1, 32), Contains("Recognizer") && Contains("-1 x 32"));
+  CHECK_THROWS_WITH(ti::Recognizer<>(32, 0), Contains(">= 1"));
+  CHECK_THROWS_WITH(ti::Recognizer<>(1 << 20, 1 << 20), Contains("at most 16777216 pixels"));
+  CHECK_THROWS_WITH(ti::Segmenter({}, -5, -5), Contains("Segmenter"));
+  CHECK_THROWS_WITH(ti::RegionAnalyzer({}, 32, -1), Contains("RegionAnalyzer"));
+  CHECK_THROWS_WITH(ti::Reconstructor({}, {}, -3, 4), Contains("Reconstructor"));
+  CHECK_THROWS_WITH(ti::Components(-1, -1), Contains("Components"));
+  CHECK_THROWS_WITH(ti::KMeans1d(3, static_cast<std::size_t>(-1)), Contains("KMeans1d"));
+  // The largest legal size still works for a tiny image.
+  CHECK_NOTHROW(ti::Recognizer<>(1, 1));
+}

@@ -220,3 +220,43 @@ TEST_CASE("VoxelHash keeps a dense cell exact when it overflows its first block"
     expect_same_answers(v, oracle, jitter(rng, taxel::Vec3d(2e-3, 2e-4, 2e-4), 2e-3));
   }
 }
+
+TEST_CASE("UniformGrid refuses clouds too wide to grid and survives huge coordinates",
+          "[index][reliability]") {
+  using G = ti::UniformGrid<double>;
+  // The extent overflows to infinity: refused at once (this construction used to loop forever).
+  CHECK_THROWS_WITH(G({{-1e308, 0, 0}, {1e308, 0, 0}}), Catch::Matchers::Contains("too wide"));
+  CHECK_THROWS_WITH(ti::UniformGrid<float>({{-3e38f, 0, 0}, {3e38f, 0, 0}}),
+                    Catch::Matchers::Contains("too wide"));
+  // Wide but legal: one tight cluster and one point 1e30 m away. Cells stay within int range
+  // and queries stay exact against brute force.
+  std::vector<taxel::Vec3<double>> pts;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  for (int i = 0; i < 200; ++i) pts.emplace_back(u(rng), u(rng), u(rng));
+  pts.emplace_back(1e30, -1e30, 1e30);
+  const G grid(pts);
+  ti::BruteForce<double> brute;
+  for (std::size_t i = 0; i < pts.size(); ++i) brute.insert(static_cast<ti::PointId>(i), pts[i]);
+  for (const taxel::Vec3<double>& q :
+       {taxel::Vec3<double>(0, 0, 0), taxel::Vec3<double>(1e29, -1e29, 1e29),
+        taxel::Vec3<double>(-1e20, 1e20, 0), taxel::Vec3<double>(5e-4, 0, -5e-4)}) {
+    const auto a = grid.nearest_within(q, std::numeric_limits<double>::infinity());
+    const auto b = brute.nearest_within(q, std::numeric_limits<double>::infinity());
+    REQUIRE(a.has_value() == b.has_value());
+    if (a) CHECK(a->id == b->id);
+  }
+  // All points equal: a valid grid of one occupied cell.
+  const G same(std::vector<taxel::Vec3<double>>(5, taxel::Vec3<double>(1, 2, 3)));
+  CHECK(same.nearest_within({1, 2, 3}, 0.0).has_value());
+}
+
+TEST_CASE("VoxelHash refuses radii a cell cannot represent and states its exact range",
+          "[index][reliability]") {
+  CHECK_THROWS_WITH(ti::VoxelHash<double>(1e-310), Catch::Matchers::Contains("radius"));
+  CHECK_THROWS_WITH(ti::VoxelHash<float>(1e-39f), Catch::Matchers::Contains("radius"));
+  CHECK_THROWS_WITH(ti::VoxelHash<double>(1e308), Catch::Matchers::Contains("radius"));
+  const ti::VoxelHash<double> h(2e-3);
+  // 2^30 - 2 cells of 2 r (1 + 1e-4): about 4.3 million metres from the origin.
+  CHECK(h.max_coordinate() == Approx((1073741824.0 - 2.0) * 4e-3 * (1 + 1e-4)));
+}

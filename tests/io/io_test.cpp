@@ -1,8 +1,13 @@
 // SPDX-License-Identifier: MIT
 // Tests of taxel::io image readers and writers: round trips, foreign conventions, and malformed
 // inputs that must be refused with the place of the error.
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+
 #include <bit>
 #include <catch2/catch.hpp>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -435,4 +440,117 @@ TEST_CASE("Contacts CSV: round trip, foreign layouts, strict errors", "[io][csv]
     CHECK_THROWS_WITH(tio::parse_contacts_csv(text), Contains(message));
   }
   CHECK_THROWS_WITH(tio::read_contacts_csv("/nonexistent.csv"), Contains("cannot open"));
+}
+
+TEST_CASE("PLY: a property named twice is refused, not silently reordered", "[io][ply]") {
+  const std::string twice =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float x\nend_header\n1 2 3 4\n";
+  CHECK_THROWS_WITH(tio::parse_ply(twice, "twice.ply"),
+                    Contains("twice.ply:7:") && Contains("two properties named 'x'"));
+  // The same name in two elements is fine.
+  const std::string two_elements =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nelement extra 1\nproperty float x\nend_header\n1 2 3\n9\n";
+  CHECK(tio::parse_ply(two_elements).cloud.points.at(0).x() == 1.0);
+}
+
+namespace {
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+std::size_t entries(const std::filesystem::path& dir) {
+  return static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(dir),
+                                                std::filesystem::directory_iterator()));
+}
+}  // namespace
+
+TEST_CASE("write_file: whole or not at all, the previous file kept on failure",
+          "[io][reliability]") {
+  const auto dir = fresh_dir("taxel_write_file_test");
+  const std::string path = (dir / "out.txt").string();
+  tio::write_file(path, "first version\n");
+  CHECK(tio::read_file(path) == "first version\n");
+  tio::write_file(path, "second");
+  CHECK(tio::read_file(path) == "second");
+  CHECK(entries(dir) == 1);  // no temporary left beside it
+
+  // Permissions of an existing file are kept.
+  ::chmod(path.c_str(), 0640);
+  tio::write_file(path, "third");
+  struct ::stat st {};
+  REQUIRE(::stat(path.c_str(), &st) == 0);
+  CHECK((st.st_mode & 0777) == 0640);
+
+  // A write that fails half way (the file size limit stands in for a full disk): the error
+  // names the file and the reason; the old content survives; nothing is left behind.
+  struct ::rlimit old {};
+  REQUIRE(::getrlimit(RLIMIT_FSIZE, &old) == 0);
+  const auto previous_handler = std::signal(SIGXFSZ, SIG_IGN);
+  struct ::rlimit small = old;
+  small.rlim_cur = 4096;
+  REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
+  std::string error;
+  try {
+    tio::write_file(path, std::string(100000, 'x'));
+  } catch (const taxel::IoError& e) {
+    error = e.what();
+  }
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, previous_handler);
+  CHECK_THAT(error, Contains("out.txt") && Contains("File too large"));
+  CHECK(tio::read_file(path) == "third");
+  CHECK(entries(dir) == 1);
+
+  // A device is written in place, and its failure reported.
+  CHECK_THROWS_WITH(tio::write_file("/dev/full", "x"),
+                    Contains("/dev/full") && Contains("No space left"));
+  tio::write_file("/dev/null", "discarded");
+  // A folder, a missing folder, an empty name.
+  CHECK_THROWS_WITH(tio::write_file(dir.string(), "x"), Contains("folder"));
+  CHECK_THROWS_WITH(tio::write_file((dir / "missing" / "x.txt").string(), "x"),
+                    Contains("missing") && Contains("No such file"));
+  CHECK_THROWS_WITH(tio::write_file("", "x"), Contains("empty"));
+
+  // A symbolic link: the file it names is replaced, the link stays a link.
+  const auto link = dir / "link.txt";
+  std::filesystem::create_symlink(dir / "out.txt", link);
+  tio::write_file(link.string(), "through the link");
+  CHECK(std::filesystem::is_symlink(link));
+  CHECK(tio::read_file(path) == "through the link");
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("read_file: folders, devices and size limits", "[io][reliability]") {
+  const auto dir = fresh_dir("taxel_read_file_test");
+  CHECK_THROWS_WITH(tio::read_file(dir.string()), Contains("is a folder"));
+  CHECK_THROWS_WITH(tio::read_file((dir / "absent").string()), Contains("No such file"));
+  CHECK(tio::read_file("/dev/null").empty());  // a device read to its end
+  tio::write_file((dir / "ten").string(), "0123456789");
+  CHECK_THROWS_WITH(tio::read_file((dir / "ten").string(), 9),
+                    Contains("ten") && Contains("the limit is 9 bytes"));
+  CHECK(tio::read_file((dir / "ten").string(), 10) == "0123456789");
+  // A device that never ends stops at the limit instead of filling memory.
+  CHECK_THROWS_WITH(tio::read_file("/dev/zero", 1 << 20), Contains("the limit is 1048576"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("libsvm: a tiny file naming a huge feature index is refused, not expanded",
+          "[io][reliability]") {
+  CHECK_THROWS_WITH(
+      tio::parse_libsvm("1 134217728:1\n", "huge.libsvm"),
+      Contains("huge.libsvm") && Contains("134217728 features") && Contains("max_values"));
+  tio::LibsvmReadOptions raised;
+  raised.max_values = std::uint64_t{1} << 28;
+  CHECK_THROWS_WITH(tio::parse_libsvm("1 1000000000:1\n", "huge.libsvm", raised),
+                    Contains("exceed"));
+}
+
+TEST_CASE("image readers refuse images beyond the size limit with the file name",
+          "[io][reliability]") {
+  CHECK_THROWS_WITH(tio::parse_pgm("P5\n8192 8192\n255\n", "big.pgm"),
+                    Contains("big.pgm") && Contains("limit"));
 }

@@ -492,3 +492,20 @@ TEST_CASE("libsvm reader errors name the line and column", "[io][learn]") {
   bad("1 5:1\n", "feature index 5 exceeds the 3 features expected", {.dims = 3});
   bad("1 100000:1\n", "exceed the dense limit", {.max_values = 1000});
 }
+
+TEST_CASE("LinearSvm refuses features whose squared norm overflows instead of a zero model",
+          "[learn][reliability]") {
+  Dataset d = taxel_test::blobs(20, 2, 3, 4.0, 7);
+  LinearSvm svm;
+  REQUIRE(svm.fit(d.view()).ok());
+  const Eigen::MatrixXd before = svm.weights();
+  Dataset huge = d;
+  huge.x *= 1e200;  // finite features, infinite ||x||^2
+  const Outcome o = svm.fit(huge.view());
+  CHECK(o.status == Status::invalid_input);
+  CHECK_THAT(o.message, Contains("squared norm of sample 0") && Contains("overflows"));
+  CHECK(svm.weights() == before);  // the previous model is kept
+  // The same through the bias feature alone (-B 1e200).
+  LinearSvm biased(LinearSvmConfig{.bias = 1e200});
+  CHECK(biased.fit(d.view()).status == Status::invalid_input);
+}

@@ -486,3 +486,59 @@ TEST_CASE("Registration works on float clouds", "[registration][icp]") {
   cloud.points = source;
   CHECK(lib.recognize(cloud).best == "object");
 }
+
+TEST_CASE("Point-to-point ICP on 1-point, 2-point and collinear targets is degenerate",
+          "[registration][icp][reliability]") {
+  Icp<PointToPoint> p2p(IcpConfig{.max_iterations = 30});
+  std::vector<Vec3d> source;
+  for (int i = 0; i < 40; ++i) {
+    source.emplace_back(0.01 * std::cos(0.3 * i), 0.008 * std::sin(0.5 * i), 0.002 * (i % 7));
+  }
+  const auto target_of = [](std::vector<Vec3d> pts) {
+    PointCloud<double> c;
+    c.points = std::move(pts);
+    return Target<double>(std::move(c));
+  };
+  for (const auto& pts :
+       {std::vector<Vec3d>{Vec3d(0, 0, 0)}, std::vector<Vec3d>{Vec3d(0, 0, 0), Vec3d(0.01, 0, 0)},
+        std::vector<Vec3d>{Vec3d(0, 0, 0), Vec3d(0.01, 0, 0), Vec3d(0.02, 0, 0),
+                           Vec3d(0.03, 0, 0)}}) {
+    const Target<double> tg = target_of(pts);
+    const IcpResult r = p2p.align(tg, std::span<const Vec3d>(source));
+    CHECK(r.status == Status::degenerate);
+    CHECK_THAT(r.message, Contains("target points are collinear or fewer than three"));
+    CHECK(r.transform.matrix().allFinite());
+  }
+}
+
+TEST_CASE("Target sizes its closest-point field to the model, never failing on a legal model",
+          "[registration][reliability]") {
+  // A model in millimetres (a 40 mm sphere written as radius 40) with the metre-scale default
+  // cell: the field grows its cell to stay within field_max_cells.
+  PointCloud<double> mm = sim::sample_surface(sim::Sphere(40.0), 2000, 5);
+  const Target<double> tg(mm, TargetConfig{.field_cell = 2e-3, .field_max_cells = 1 << 18});
+  CHECK(tg.has_field());
+  CHECK(tg.field_cell() > 2e-3);
+  // Exact queries stay exact.
+  const index::BruteForce<double> brute = [&] {
+    index::BruteForce<double> b;
+    for (std::size_t i = 0; i < mm.points.size(); ++i) {
+      b.insert(static_cast<index::PointId>(i), mm.points[i]);
+    }
+    return b;
+  }();
+  for (const Vec3d& q : {Vec3d(0, 0, 0), Vec3d(45, 3, -2), Vec3d(-10, 70, 5)}) {
+    const auto a = tg.nearest_within(q, 1e9);
+    const auto b = brute.nearest_within(q, 1e9);
+    REQUIRE(a.has_value());
+    CHECK(a->id == b->id);
+  }
+  // Float coordinates near the float limit: the field's counts never reach an int cast.
+  PointCloud<float> huge;
+  huge.points = {Vec3<float>(-1e37f, 0, 0), Vec3<float>(1e37f, 0, 0), Vec3<float>(0, 1e37f, 0),
+                 Vec3<float>(0, 0, 1e37f)};
+  const Target<float> big(huge, TargetConfig{.field_cell = 1e-3, .field_max_cells = 4096});
+  CHECK(big.has_field());
+  CHECK_THROWS_WITH(Target<double>(mm, TargetConfig{.field_cell = 1e-3, .field_max_cells = 0}),
+                    Contains("field_max_cells"));
+}

@@ -74,6 +74,9 @@ enum class ContactDefect {
   indefinite_covariance,  ///< covariance is not positive definite
   bad_normal,             ///< normal is present but not finite or not of unit length (1e-3)
   overflow,               ///< fusing it would overflow the model (extreme magnitudes)
+  non_finite_time,        ///< time is NaN or Inf
+  non_finite_pressure,    ///< pressure is NaN or Inf
+  out_of_range,           ///< position beyond what the cloud's index separates exactly
 };
 
 /// Short description of a contact defect.
@@ -93,6 +96,12 @@ constexpr std::string_view to_string(ContactDefect d) noexcept {
       return "normal is not a finite unit vector";
     case ContactDefect::overflow:
       return "fusing it would overflow";
+    case ContactDefect::non_finite_time:
+      return "time is not finite";
+    case ContactDefect::non_finite_pressure:
+      return "pressure is not finite";
+    case ContactDefect::out_of_range:
+      return "position is beyond the index's range";
   }
   return "unknown";
 }
@@ -135,6 +144,8 @@ ContactDefect check_contact(const Contact<S>& c) noexcept {
     const S n2 = c.normal->squaredNorm();
     if (!(n2 >= S(0.999 * 0.999) && n2 <= S(1.001 * 1.001))) return ContactDefect::bad_normal;
   }
+  if (!std::isfinite(c.time)) return ContactDefect::non_finite_time;
+  if (!std::isfinite(c.pressure)) return ContactDefect::non_finite_pressure;
   return ContactDefect::ok;
 }
 

@@ -103,6 +103,11 @@ class ContactCloud {
   InsertResult insert(const Contact<Scalar>& contact) {
     const ContactDefect defect = check_contact(contact);
     if (defect != ContactDefect::ok) return {InsertStatus::rejected, 0, defect};
+    if constexpr (requires(const I& ix) { ix.max_coordinate(); }) {
+      if (!(contact.position.cwiseAbs().maxCoeff() <= index_.max_coordinate())) {
+        return {InsertStatus::rejected, 0, ContactDefect::out_of_range};
+      }
+    }
     if constexpr (F::kMerges) {
       if (const auto hit = index_.nearest_within(contact.position, config_.association_radius)) {
         const index::PointId id = hit->id;

@@ -24,6 +24,7 @@ class Components {
 
   /// Preallocates for `rows x cols` images.
   void reserve(Eigen::Index rows, Eigen::Index cols) {
+    detail::checked_pixels("Components", rows, cols);
     labels_.resize(rows, cols);
     parent_.reserve(max_labels(rows, cols));
     remap_.reserve(max_labels(rows, cols));

@@ -64,6 +64,10 @@ class KMeans1d {
 
   /// Preallocates for up to `n` values.
   void reserve(std::size_t n) {
+    if (n > (std::size_t{1} << 40)) {
+      throw std::invalid_argument("KMeans1d: cannot reserve for " + std::to_string(n) +
+                                  " values (at most 2^40)");
+    }
     keys_.reserve(std::bit_ceil(2 * few_cap(n)));
     counts_.reserve(std::bit_ceil(2 * few_cap(n)));
     few_.reserve(few_cap(n));

@@ -86,7 +86,7 @@ class Recognizer {
  public:
   explicit Recognizer(Eigen::Index rows = 32, Eigen::Index cols = 32, RecognizerConfig cfg = {},
                       Decider decider = {}, Classifier classifier = {})
-      : rows_(rows),
+      : rows_((checked_size(rows, cols), rows)),
         cols_(cols),
         cfg_(cfg),
         decider_(std::move(decider)),
@@ -95,9 +95,6 @@ class Recognizer {
         analyzer_(RegionPropsOptions{.zero_based = false, .convex = true, .perimeter = false}, rows,
                   cols),
         reconstructor_(cfg.edged, cfg.edgeless, rows, cols) {
-    if (rows < 1 || cols < 1) {
-      throw std::invalid_argument("Recognizer: rows and cols must be >= 1");
-    }
     result_.regional.setZero(kRegionalFeatures);
     result_.edge_features.setZero(kEdgeFeatures);
     result_.hybrid.setZero(rows * cols + kRegionalFeatures);
@@ -211,6 +208,15 @@ class Recognizer {
   [[nodiscard]] const RecognizerConfig& config() const noexcept { return cfg_; }
 
  private:
+  // Runs before any member allocates: sizes >= 1 and at most kMaxImagePixels pixels.
+  static void checked_size(Eigen::Index rows, Eigen::Index cols) {
+    if (rows < 1 || cols < 1) {
+      throw std::invalid_argument("Recognizer: rows and cols must be >= 1, got " +
+                                  std::to_string(rows) + " x " + std::to_string(cols));
+    }
+    detail::checked_pixels("Recognizer", rows, cols);
+  }
+
   Eigen::Index rows_, cols_;
   RecognizerConfig cfg_;
   Decider decider_;

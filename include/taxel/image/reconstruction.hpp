@@ -82,6 +82,7 @@ class Reconstructor {
       : edged_(edged), edgeless_(edgeless) {
     edged.validate();
     edgeless.validate();
+    detail::checked_pixels("Reconstructor", rows, cols);
     height_.resize(rows, cols);
     scratch_.resize(rows, cols);
     block_.resize(rows, cols);

@@ -60,7 +60,7 @@ class RegionAnalyzer {
  public:
   explicit RegionAnalyzer(RegionPropsOptions opt = {}, Eigen::Index rows = 32,
                           Eigen::Index cols = 32)
-      : opt_(opt), components_(rows, cols) {
+      : opt_(opt), components_((detail::checked_pixels("RegionAnalyzer", rows, cols), rows), cols) {
     points_.reserve(4 * static_cast<std::size_t>(rows) + 8);
     hull_.reserve(4 * static_cast<std::size_t>(rows) + 8);
     row_first_.reserve(static_cast<std::size_t>(rows));

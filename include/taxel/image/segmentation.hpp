@@ -56,7 +56,9 @@ class Segmenter {
  public:
   /// Throws std::invalid_argument on a bad configuration, naming the field.
   explicit Segmenter(SegmentationConfig cfg = {}, Eigen::Index rows = 32, Eigen::Index cols = 32)
-      : cfg_(cfg), kmeans_(cfg.k, static_cast<std::size_t>(rows * cols)), components_(rows, cols) {
+      : cfg_(cfg),
+        kmeans_(cfg.k, static_cast<std::size_t>(detail::checked_pixels("Segmenter", rows, cols))),
+        components_(rows, cols) {
     if (cfg.k < 2 || cfg.k > 255) {
       throw std::invalid_argument("SegmentationConfig::k = " + std::to_string(cfg.k) +
                                   " is outside the allowed range [2, 255]");

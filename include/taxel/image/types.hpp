@@ -6,6 +6,8 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 
 namespace taxel::image {
@@ -32,8 +34,9 @@ enum class Connectivity : int {
   eight = 8,  ///< edge and corner neighbours (MATLAB's default for 2-D)
 };
 
-/// Which end of the intensity scale means pressure. The second paper's text and its figure
-/// captions disagree (PAPERS.md 2.6 #1); taxel defaults to the physically meaningful reading.
+/// Which end of the intensity scale means pressure. The second paper's text (its segmentation
+/// keeps the "lowest centroid" class) and its figure captions (dark = no contact) disagree;
+/// taxel defaults to the physically meaningful reading.
 enum class Polarity {
   high_is_pressure,  ///< larger values = more pressure (sensor counts, the figure captions)
   dark_is_pressure,  ///< smaller values = more pressure (the text's "lowest centroid" wording)
@@ -44,7 +47,23 @@ constexpr std::string_view to_string(Polarity p) noexcept {
   return p == Polarity::high_is_pressure ? "high_is_pressure" : "dark_is_pressure";
 }
 
+/// Largest image the preallocating image types (Segmenter, RegionAnalyzer, Reconstructor,
+/// Recognizer) accept: 2^24 pixels (4096 x 4096).
+inline constexpr Eigen::Index kMaxImagePixels = Eigen::Index{1} << 24;
+
 namespace detail {
+
+/// `rows * cols` when both are >= 0 and the product is at most kMaxImagePixels; otherwise
+/// throws std::invalid_argument naming `who` (a negative size never reaches an allocation).
+inline Eigen::Index checked_pixels(const char* who, Eigen::Index rows, Eigen::Index cols) {
+  if (rows < 0 || cols < 0 || (cols > 0 && rows > kMaxImagePixels / cols)) {
+    throw std::invalid_argument(std::string(who) + ": an image of " + std::to_string(rows) + " x " +
+                                std::to_string(cols) +
+                                " pixels; rows and cols must be >= 0 with at most " +
+                                std::to_string(kMaxImagePixels) + " pixels");
+  }
+  return rows * cols;
+}
 
 /// The non-zero pixels of a mask row of at most 64 pixels as bits (bit c = pixel c).
 inline std::uint64_t pack_row(const std::uint8_t* m, Eigen::Index cols) noexcept {

@@ -65,12 +65,25 @@ class UniformGrid {
       lo_ = lo_.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
-    const Vec3<S> extent = hi - lo_;
     if (!(config.spacing_factor > 0.0) || !std::isfinite(config.spacing_factor)) {
       throw std::invalid_argument("UniformGrid::Config: spacing_factor must be finite and > 0");
     }
+    // The box is measured in double (no overflow for float points); a box too wide for S to
+    // hold its extent or a cell (points near +-max) is refused rather than looped over.
+    const Vec3d extent = hi.template cast<double>() - lo_.template cast<double>();
+    const double widest = extent.maxCoeff();
+    if (!std::isfinite(widest) ||
+        widest > 0.25 * static_cast<double>(std::numeric_limits<S>::max())) {
+      throw std::invalid_argument(
+          "UniformGrid: the points span " + std::to_string(widest) +
+          " along one axis, too wide to grid; coordinates must stay within +-" +
+          std::to_string(0.125 * static_cast<double>(std::numeric_limits<S>::max())));
+    }
     double cell = config.cell > S(0) ? static_cast<double>(config.cell)
                                      : config.spacing_factor * mean_spacing();
+    // A cell at least a 2^-20 of the widest extent keeps every cell coordinate far inside int
+    // range; finer cells would exceed max_cells anyway.
+    cell = std::max({cell, widest * 0x1p-20, static_cast<double>(std::numeric_limits<S>::min())});
     for (;;) {
       std::array<double, 3> n{};
       double total = 1.0;
@@ -85,6 +98,7 @@ class UniformGrid {
           dims_[static_cast<std::size_t>(a)] = static_cast<int>(n[static_cast<std::size_t>(a)]);
         break;
       }
+      // Grows by at least 1 %; `total` is finite, as extent / cell <= 2^20 per axis.
       cell *= std::cbrt(total / static_cast<double>(config.max_cells)) * 1.01;
     }
     cell_ = static_cast<S>(cell);
@@ -202,8 +216,10 @@ class UniformGrid {
   [[nodiscard]] std::size_t cell_index(const Vec3<S>& c) const {
     std::array<int, 3> i{};
     for (int a = 0; a < 3; ++a) {
-      i[static_cast<std::size_t>(a)] =
-          std::clamp(static_cast<int>(std::floor(c[a])), 0, dims_[static_cast<std::size_t>(a)] - 1);
+      // Clamped in floating point first: huge or NaN coordinates never reach the int cast.
+      const double top = dims_[static_cast<std::size_t>(a)] - 1;
+      const double x = std::floor(static_cast<double>(c[a]));
+      i[static_cast<std::size_t>(a)] = static_cast<int>(x >= 0.0 ? std::min(x, top) : 0.0);
     }
     return (static_cast<std::size_t>(i[2]) * dims_[1] + i[1]) * dims_[0] + i[0];
   }

@@ -64,9 +64,17 @@ class VoxelHash {
     radius_ = radius;
     cell_ = S(2) * radius * (S(1) + kMargin);
     inv_cell_ = S(1) / cell_;
+    if (!std::isfinite(cell_) || !std::isfinite(inv_cell_) || !(inv_cell_ > S(0))) {
+      throw std::invalid_argument("VoxelHash: radius " + std::to_string(radius) +
+                                  " is too small or too large for a cell of type S");
+    }
     slots_.assign(16, Slot{});
   }
 
+  /// Largest |coordinate| the hash separates exactly [m]: 2^30 - 2 cells from the origin.
+  /// Farther points share clamped border cells (correct, but slow when many do), so
+  /// ContactCloud rejects contacts beyond it.
+  [[nodiscard]] S max_coordinate() const noexcept { return (kMaxCell - S(2)) * cell_; }
   /// Side of a cell [m].
   [[nodiscard]] S cell_size() const noexcept { return cell_; }
 

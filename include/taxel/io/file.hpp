@@ -1,11 +1,18 @@
 // SPDX-License-Identifier: MIT
-// Whole-file reading and writing with errors that name the file (taxel::IoError).
+// Whole-file reading and writing with errors that name the file (taxel::IoError). Writes are
+// atomic on POSIX systems: a temporary file beside the target, flushed, then renamed.
 #pragma once
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <string_view>
 
@@ -50,30 +57,122 @@ inline bool blank_or_comment(std::string_view line) noexcept {
 /// Largest file the readers accept (1 GiB); larger inputs are refused, not read.
 inline constexpr std::uint64_t kMaxFileBytes = std::uint64_t{1} << 30;
 
-/// Reads a whole file into memory. Throws IoError when it cannot be opened or read, or is
-/// larger than `max_bytes`.
+/// Reads a whole file into memory: a regular file, or a pipe or device (standard input,
+/// `<(...)`) read to its end. Throws IoError when it cannot be opened or read, is a folder, or
+/// is larger than `max_bytes`.
 inline std::string read_file(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw IoError(path, std::string("cannot open for reading: ") + std::strerror(errno));
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw IoError(path, "cannot determine the file size");
-  if (static_cast<std::uint64_t>(size) > max_bytes) {
-    throw IoError(path, "file is " + std::to_string(size) + " bytes; the limit is " +
-                            std::to_string(max_bytes));
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError(path, std::string("cannot open for reading: ") + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct ::stat st {};
+  if (::fstat(fd, &st) != 0)
+    throw IoError(path, std::string("cannot stat: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw IoError(path, "is a folder, not a file");
+  const auto too_large = [&](std::uint64_t size) {
+    return IoError(path, "file is " + std::to_string(size) + " bytes or more; the limit is " +
+                             std::to_string(max_bytes) + " bytes");
+  };
+  std::string bytes;
+  if (S_ISREG(st.st_mode)) {
+    if (static_cast<std::uint64_t>(st.st_size) > max_bytes)
+      throw too_large(static_cast<std::uint64_t>(st.st_size));
+    bytes.reserve(static_cast<std::size_t>(st.st_size));
   }
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  in.seekg(0);
-  if (size > 0 && !in.read(bytes.data(), size)) throw IoError(path, "read failed");
+  char buffer[1 << 16];
+  for (;;) {
+    const ::ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw IoError(path, std::string("read failed: ") + std::strerror(errno));
+    }
+    if (n == 0) break;
+    if (bytes.size() + static_cast<std::size_t>(n) > max_bytes) {
+      throw too_large(bytes.size() + static_cast<std::size_t>(n));
+    }
+    bytes.append(buffer, static_cast<std::size_t>(n));
+  }
   return bytes;
 }
 
-/// Writes `bytes` to `path`, replacing it. Throws IoError on failure.
+namespace detail {
+
+/// Writes all of `bytes` to the open descriptor `fd`, retrying short writes and EINTR; returns
+/// 0 or the errno of the failure.
+inline int write_all(int fd, std::string_view bytes) noexcept {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const std::size_t chunk = std::min<std::size_t>(bytes.size() - done, std::size_t{1} << 30);
+    const ::ssize_t n = ::write(fd, bytes.data() + done, chunk);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    if (n == 0) return EIO;
+    done += static_cast<std::size_t>(n);
+  }
+  return 0;
+}
+
+/// A name for a temporary file beside `target` that no other writer in this or another
+/// process picks: the target's name, the process id and a counter.
+inline std::string temporary_beside(const std::string& target) {
+  static std::atomic<unsigned long> counter{0};
+  const auto slash = target.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? std::string() : target.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? target : target.substr(slash + 1);
+  return dir + "." + name + ".tmp." + std::to_string(static_cast<long>(::getpid())) + "." +
+         std::to_string(counter.fetch_add(1));
+}
+
+}  // namespace detail
+
+/// Writes `bytes` to `path` whole or not at all. A regular file (or a new one) is written to a
+/// temporary file in the same folder, flushed to the device (fsync), checked, and renamed over
+/// `path`: after any failure the previous file is intact and no partial file is left. A
+/// symbolic link is followed (the file it names is replaced, the link stays). A path that names
+/// a device or a pipe (`/dev/stdout`, `/dev/null`) is written in place and every write checked.
+/// Throws IoError naming the file and the reason (for example "No space left on device").
+/// Thread-safe for distinct paths.
 inline void write_file(const std::string& path, std::string_view bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.flush();
-  if (!out) throw IoError(path, "write failed");
+  if (path.empty()) throw IoError(path, "cannot write: the file name is empty");
+  std::string target = path;
+  struct ::stat st {};
+  bool exists = ::stat(path.c_str(), &st) == 0;
+  if (exists && S_ISDIR(st.st_mode)) throw IoError(path, "cannot write: it is a folder");
+  if (exists && !S_ISREG(st.st_mode)) {  // a device or a pipe: there is nothing to replace
+    const int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+    if (fd < 0)
+      throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
+    int err = detail::write_all(fd, bytes);
+    if (::close(fd) != 0 && err == 0) err = errno;
+    if (err != 0) throw IoError(path, std::string("write failed: ") + std::strerror(err));
+    return;
+  }
+  struct ::stat lst {};
+  if (exists && ::lstat(path.c_str(), &lst) == 0 && S_ISLNK(lst.st_mode)) {
+    if (char* real = ::realpath(path.c_str(), nullptr)) {
+      target = real;
+      std::free(real);
+    }
+  }
+  const std::string tmp = detail::temporary_beside(target);
+  // 0666 minus the umask, as a plain open would; an existing file keeps its permissions.
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0)
+    throw IoError(path, std::string("cannot create a file beside it: ") + std::strerror(errno));
+  int err = detail::write_all(fd, bytes);
+  if (err == 0 && exists) (void)::fchmod(fd, st.st_mode & 07777);
+  if (err == 0 && ::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) err = errno;
+  if (::close(fd) != 0 && err == 0) err = errno;
+  if (err == 0 && ::rename(tmp.c_str(), target.c_str()) != 0) err = errno;
+  if (err != 0) {
+    ::unlink(tmp.c_str());
+    throw IoError(path, std::string("write failed (the previous file, if any, is unchanged): ") +
+                            std::strerror(err));
+  }
 }
 
 /// Lower-case extension of a path including the dot ("" when there is none).

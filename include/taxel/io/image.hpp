@@ -26,8 +26,9 @@
 
 namespace taxel::io {
 
-/// Largest image the readers accept, in pixels over all frames (2^26 = 64 Mi values).
-inline constexpr std::uint64_t kMaxImageValues = std::uint64_t{1} << 26;
+/// Largest image the readers accept, in pixels over all frames: 2^24 = 16 Mi values (128 MiB
+/// as doubles; 16 000 frames of 32 x 32). Larger files are refused before any allocation.
+inline constexpr std::uint64_t kMaxImageValues = std::uint64_t{1} << 24;
 
 /// One image or a stack of equally sized frames, row-major, frame after frame.
 struct ImageStack {

@@ -24,8 +24,9 @@ struct LibsvmReadOptions {
   /// Features per sample: 0 takes the largest index in the file; a positive value fixes the
   /// width (an index above it is an error), as when reading a test set for a trained model.
   long long dims = 0;
-  /// Largest dense matrix (rows x features) the reader will allocate.
-  std::uint64_t max_values = std::uint64_t{1} << 28;
+  /// Largest dense matrix (rows x features) the reader will allocate: 2^24 values (128 MiB)
+  /// by default, so a small file naming a huge feature index is refused, not expanded.
+  std::uint64_t max_values = std::uint64_t{1} << 24;
 };
 
 namespace detail {
@@ -165,7 +166,8 @@ inline learn::Dataset parse_libsvm(std::string_view text, const std::string& sou
       static_cast<double>(opt.max_values)) {
     throw IoError(source, std::to_string(labels.size()) + " samples x " + std::to_string(dims) +
                               " features exceed the dense limit of " +
-                              std::to_string(opt.max_values) + " values");
+                              std::to_string(opt.max_values) +
+                              " values (LibsvmReadOptions::max_values)");
   }
   learn::Dataset d;
   d.x = learn::FeatureMatrix::Zero(static_cast<Eigen::Index>(labels.size()),

@@ -17,6 +17,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <unordered_set>
 #include <vector>
 
 #include "taxel/core/error.hpp"
@@ -221,6 +222,7 @@ inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<p
   bool binary = false;
   bool have_format = false;
   std::vector<PlyElement> elements;
+  std::unordered_set<std::string> property_names;  // of the current element
   for (;;) {
     next_line(l);
     const auto w = words(l);
@@ -246,6 +248,7 @@ inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<p
         throw IoError(source, "malformed element line", line);
       }
       elements.push_back({std::string(w[1]), n, {}});
+      property_names.clear();
     } else if (w[0] == "property") {
       if (elements.empty()) throw IoError(source, "property before any element", line);
       PlyProperty p;
@@ -264,6 +267,12 @@ inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<p
         p.name = std::string(w[2]);
       } else {
         throw IoError(source, "malformed property line", line);
+      }
+      if (!property_names.insert(p.name).second) {
+        throw IoError(source,
+                      "element '" + elements.back().name.substr(0, 24) +
+                          "' has two properties named '" + p.name.substr(0, 24) + "'",
+                      line);
       }
       elements.back().properties.push_back(std::move(p));
     } else {
@@ -305,7 +314,7 @@ inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<p
         if (p.list) continue;
         const std::string_view n = p.name;
         for (int a = 0; a < 3; ++a) {
-          if (n == std::string_view("xyz" + a, 1)) xyz[a] = static_cast<int>(i);
+          if (n == std::string_view(&"xyz"[a], 1)) xyz[a] = static_cast<int>(i);
           if (n.size() == 2 && n[0] == 'n' && n[1] == "xyz"[a]) nxyz[a] = static_cast<int>(i);
         }
       }

@@ -80,7 +80,15 @@ class LinearSvm {
 
     Eigen::VectorXd qd_base(n);  // ||x_i||^2 + bias^2
     const double b2 = cfg_.bias >= 0.0 ? cfg_.bias * cfg_.bias : 0.0;
-    for (Eigen::Index i = 0; i < n; ++i) qd_base(i) = d.x.row(i).squaredNorm() + b2;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      qd_base(i) = d.x.row(i).squaredNorm() + b2;
+      // An overflowing ||x||^2 would make every dual step 0 and return an all-zero model.
+      if (!std::isfinite(qd_base(i))) {
+        return {Status::invalid_input,
+                "LinearSvm: the squared norm of sample " + std::to_string(i) +
+                    " (with the bias feature) overflows; scale the features (and -B) below 1e150"};
+      }
+    }
 
     FeatureMatrix w(nr_w, dims);
     Eigen::VectorXd wb(nr_w);
@@ -110,6 +118,10 @@ class LinearSvm {
                           " before the projected gradient spread fell to eps; scale the "
                           "features or raise eps"};
       }
+    }
+    if (!w.allFinite() || !wb.allFinite()) {
+      return {Status::invalid_input,
+              "LinearSvm: the weights overflowed during training; scale the features or lower C"};
     }
     classes_ = std::move(classes);
     w_ = std::move(w);

@@ -103,17 +103,27 @@ struct PointToPoint {
     if (!(wsum > 0.0)) return {Status::degenerate, "every correspondence has zero weight"};
     pm /= wsum;
     qm /= wsum;
-    Mat3d h = Mat3d::Zero(), spread = Mat3d::Zero();
+    Mat3d h = Mat3d::Zero(), spread = Mat3d::Zero(), target_spread = Mat3d::Zero();
     for (const auto& c : cs) {
       const Vec3d dp = c.p - pm;
-      h += c.weight * dp * (c.q - qm).transpose();
+      const Vec3d dq = c.q - qm;
+      h += c.weight * dp * dq.transpose();
       spread += c.weight * dp * dp.transpose();
+      target_spread += c.weight * dq * dq.transpose();
     }
+    // Both ends must span a plane: collinear (or coincident) points on either side leave the
+    // rotation about their line free.
     const Eigen::SelfAdjointEigenSolver<Mat3d> eig(spread, Eigen::EigenvaluesOnly);
     if (!(eig.eigenvalues()(1) > 1e-12 * eig.eigenvalues()(2))) {
       return {Status::degenerate,
               "the source points are collinear: the rotation about their "
               "line is not determined"};
+    }
+    const Eigen::SelfAdjointEigenSolver<Mat3d> teig(target_spread, Eigen::EigenvaluesOnly);
+    if (!(teig.eigenvalues()(1) > 1e-12 * teig.eigenvalues()(2))) {
+      return {Status::degenerate,
+              "the matched target points are collinear or fewer than three: the rotation "
+              "about their line is not determined"};
     }
     const Eigen::JacobiSVD<Mat3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Mat3d d = Mat3d::Identity();
@@ -334,12 +344,12 @@ class Icp {
         return last;
       }
       previous_rmse = rmse;
-      Isometry3d delta;
+      Isometry3d delta = Isometry3d::Identity();
       last = Error::solve(pairs_, delta);
-      if (!delta.matrix().allFinite()) return {Status::degenerate, "the update is not finite"};
       if (last.status == Status::degenerate && Error::min_correspondences == 3) {
         return last;  // nothing to apply
       }
+      if (!delta.matrix().allFinite()) return {Status::degenerate, "the update is not finite"};
       t = delta * t;
       // Re-orthonormalise against drift over many updates.
       t.linear() = Eigen::Quaterniond(t.linear()).normalized().toRotationMatrix();

@@ -38,6 +38,10 @@ struct TargetConfig {
   /// nearest point to its centre, so a lookup errs by at most half a cell diagonal.
   double field_cell = 0.0;
   double field_margin = 0.02;
+  /// Largest number of field cells, >= 1: on a model too large for `field_cell` the cell grows
+  /// until the field fits (`Target::field_cell()` tells the edge used), so any legal model gets
+  /// a field of bounded memory (4 bytes a cell).
+  std::size_t field_max_cells = std::size_t{1} << 22;
 };
 
 /// A model prepared for registration. Normals estimated by PCA are oriented away from the
@@ -77,7 +81,7 @@ class Target {
       radius_ = std::max(radius_, (p.template cast<double>() - centroid_).norm());
     }
     if (normals_.empty()) estimate_normals(cfg.normal_neighbors);
-    if (cfg.field_cell > 0.0) build_field(cfg.field_cell, cfg.field_margin);
+    if (cfg.field_cell > 0.0) build_field(cfg.field_cell, cfg.field_margin, cfg.field_max_cells);
   }
 
   /// Number of points.
@@ -120,6 +124,9 @@ class Target {
   }
   /// True when the target has a closest-point field.
   [[nodiscard]] bool has_field() const noexcept { return !field_.empty(); }
+  /// The field's cell edge [m] (TargetConfig::field_cell, or larger on a model too big for it;
+  /// 0 without a field).
+  [[nodiscard]] double field_cell() const noexcept { return field_cell_; }
 
   /// Centroid of the points.
   [[nodiscard]] const Vec3d& centroid() const noexcept { return centroid_; }
@@ -171,9 +178,11 @@ class Target {
     return field_lo_ + field_cell_ * Vec3d(x + 0.5, y + 0.5, z + 0.5);
   }
 
-  void build_field(double cell, double margin) {
-    if (!std::isfinite(cell) || !(margin >= 0.0) || !std::isfinite(margin)) {
-      throw std::invalid_argument("TargetConfig: field_cell and field_margin must be finite");
+  void build_field(double cell, double margin, std::size_t max_cells) {
+    if (!std::isfinite(cell) || !(margin >= 0.0) || !std::isfinite(margin) || max_cells == 0) {
+      throw std::invalid_argument(
+          "TargetConfig: field_cell and field_margin must be finite, field_margin >= 0 and "
+          "field_max_cells >= 1");
     }
     const auto& pts = grid_.points();
     Vec3d lo = pts.front().template cast<double>(), hi = lo;
@@ -183,19 +192,29 @@ class Target {
     }
     field_lo_ = lo - Vec3d::Constant(margin);
     const Vec3d extent = hi - lo + Vec3d::Constant(2.0 * margin);
+    if (!extent.allFinite()) {
+      throw std::invalid_argument("TargetConfig::field_margin: the field's box overflows");
+    }
+    // Never finer than extent / 2^20 per axis, so the counts below are exact and finite.
+    cell = std::max(cell, extent.maxCoeff() * 0x1p-20);
+    std::array<double, 3> n{};
+    for (;;) {
+      double cells = 1.0;
+      for (std::size_t a = 0; a < 3; ++a) {
+        n[a] = std::ceil(extent[static_cast<int>(a)] / cell) + 1.0;
+        cells *= n[a];
+      }
+      if (cells <= static_cast<double>(max_cells)) break;
+      cell *= std::cbrt(cells / static_cast<double>(max_cells)) * 1.01;
+    }
+    for (std::size_t a = 0; a < 3; ++a) field_dims_[a] = static_cast<int>(n[a]);
     field_cell_ = cell;
     field_half_diagonal_ = 0.5 * std::sqrt(3.0) * cell;
-    double cells = 1.0;
-    for (int a = 0; a < 3; ++a) {
-      field_dims_[static_cast<std::size_t>(a)] = static_cast<int>(std::ceil(extent[a] / cell)) + 1;
-      cells *= field_dims_[static_cast<std::size_t>(a)];
-    }
-    if (cells > static_cast<double>(std::size_t{1} << 26)) {
-      throw std::invalid_argument("TargetConfig::field_cell is too small for the model: " +
-                                  std::to_string(static_cast<long long>(cells)) + " cells");
-    }
+    const std::size_t cells = static_cast<std::size_t>(field_dims_[0]) *
+                              static_cast<std::size_t>(field_dims_[1]) *
+                              static_cast<std::size_t>(field_dims_[2]);
     // Filled aside: nearest_within uses field_ only once it is complete.
-    std::vector<index::PointId> field(static_cast<std::size_t>(cells));
+    std::vector<index::PointId> field(cells);
     std::size_t i = 0;
     for (int z = 0; z < field_dims_[2]; ++z) {
       for (int y = 0; y < field_dims_[1]; ++y) {

@@ -176,6 +176,9 @@ class DsaconDevice {
   const dsa::SensorInfo& sensor_info() const noexcept { return sensor_; }
   const std::vector<dsa::MatrixInfo>& matrices() const noexcept { return matrices_; }
   std::size_t cells() const noexcept { return cells_; }
+  /// Bytes received but not yet a whole packet: after the last frame of a finished stream, a
+  /// non-zero count means that frame was cut off.
+  std::size_t unparsed_bytes() const noexcept { return parser_.buffered(); }
   DsaconStats stats() const {
     DsaconStats s = stats_;
     s.link = parser_.stats();

@@ -18,9 +18,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <span>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -38,6 +36,7 @@ struct SessionChunk {
   double time = 0.0;       ///< seconds since the session started
   bool to_device = false;  ///< true: host -> device ('>'); false: device -> host ('<')
   std::vector<std::uint8_t> bytes;
+  std::uint64_t line = 0;  ///< line in the session file (0: not read from a file)
 };
 
 /// A malformed session file; the message names the source and line.
@@ -45,14 +44,50 @@ struct SessionError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+namespace detail {
+inline std::vector<SessionChunk> parse_session_lines(std::string_view text,
+                                                     const std::string& source,
+                                                     std::vector<SessionChunk>* kept);
+}  // namespace detail
+
+/// A session file read up to its first malformed line.
+struct SessionPrefix {
+  std::vector<SessionChunk> chunks;  ///< every chunk before the first malformed line
+  std::string error;                 ///< "<source>:<line>: <why>", or empty for a whole file
+};
+
+/// Parses a session from text, keeping every chunk before the first malformed line (a
+/// recording cut short, or damaged near its end, still replays up to the damage); `error`
+/// names the source, the line and what is wrong.
+inline SessionPrefix parse_session_prefix(std::string_view text,
+                                          const std::string& source = "<session>") {
+  SessionPrefix result;
+  try {
+    result.chunks = detail::parse_session_lines(text, source, &result.chunks);
+  } catch (const SessionError& e) {
+    result.error = e.what();
+  }
+  return result;
+}
+
 /// Parses a session from text. Throws SessionError naming `source`, the line and what is wrong.
 inline std::vector<SessionChunk> parse_session(std::string_view text,
                                                const std::string& source = "<session>") {
+  return detail::parse_session_lines(text, source, nullptr);
+}
+
+namespace detail {
+// Parses every line; on a malformed one throws SessionError, after moving the chunks parsed so
+// far to *kept (when given).
+inline std::vector<SessionChunk> parse_session_lines(std::string_view text,
+                                                     const std::string& source,
+                                                     std::vector<SessionChunk>* kept) {
   std::vector<SessionChunk> out;
   std::uint64_t line_no = 0;
   bool header = false;
   double last_time = 0.0;
   const auto fail = [&](const std::string& why) {
+    if (kept != nullptr) *kept = std::move(out);
     throw SessionError(source + ":" + std::to_string(line_no) + ": " + why);
   };
   io::LineReader lines(text);
@@ -72,6 +107,7 @@ inline std::vector<SessionChunk> parse_session(std::string_view text,
     const std::string_view dir = line.substr(s1 + 1, s2 - s1 - 1);
     const std::string_view hex = line.substr(s2 + 1);
     SessionChunk c;
+    c.line = line_no;
     char* stop = nullptr;
     c.time = std::strtod(time_text.c_str(), &stop);
     if (time_text.empty() || stop != time_text.c_str() + time_text.size() ||
@@ -106,14 +142,17 @@ inline std::vector<SessionChunk> parse_session(std::string_view text,
   }
   return out;
 }
+}  // namespace detail
 
-/// Reads a session file. Throws SessionError (malformed) or std::runtime_error (unreadable).
+/// Reads a session file. Throws SessionError (malformed) or taxel::IoError (unreadable).
 inline std::vector<SessionChunk> read_session(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_session(ss.str(), path);
+  return parse_session(io::read_file(path), path);
+}
+
+/// Reads a session file up to its first malformed line (see parse_session_prefix). Throws
+/// taxel::IoError when the file cannot be read.
+inline SessionPrefix read_session_prefix(const std::string& path) {
+  return parse_session_prefix(io::read_file(path), path);
 }
 
 /// The text of a session.
@@ -133,12 +172,9 @@ inline std::string format_session(std::span<const SessionChunk> chunks) {
   return out;
 }
 
-/// Writes a session file; throws std::runtime_error when it cannot.
+/// Writes a session file whole or not at all (taxel::io::write_file); throws taxel::IoError.
 inline void write_session(const std::string& path, std::span<const SessionChunk> chunks) {
-  std::ofstream out(path, std::ios::binary);
-  const std::string text = format_session(chunks);
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  if (!out) throw std::runtime_error(path + ": cannot write");
+  io::write_file(path, format_session(chunks));
 }
 
 /// Wraps a transport and records every chunk written and read, with its time.
@@ -206,6 +242,36 @@ class ReplayTransport {
   /// True between open() and close().
   bool is_open() const { return open_; }
   bool finished() const { return host_ >= chunks_.size() && dev_ >= chunks_.size(); }
+  /// True when every recorded device-to-host byte has been read.
+  bool device_finished() const { return dev_ >= chunks_.size(); }
+
+  /// Why recorded device bytes remain unread, or "" when none do. Call when reads stop
+  /// returning data: a device chunk that waits for host bytes the host never wrote means the
+  /// host and the recording went out of step (for example a flipped direction marker). The
+  /// replies to the recording's last host command (a stop the host has not sent yet) are not
+  /// counted.
+  std::string stall_reason() const {
+    std::size_t last_host = chunks_.size();
+    for (std::size_t i = chunks_.size(); i-- > 0;) {
+      if (chunks_[i].to_device) {
+        last_host = i;
+        break;
+      }
+    }
+    if (dev_ >= chunks_.size() || (last_host < chunks_.size() && dev_ > last_host)) return {};
+    std::size_t left = chunks_[dev_].bytes.size() - dev_off_;
+    for (std::size_t i = next(dev_ + 1, false); i < chunks_.size(); i = next(i + 1, false)) {
+      left += chunks_[i].bytes.size();
+    }
+    std::string why = "replay out of step: " + std::to_string(left) +
+                      " recorded device bytes were never read, from chunk " +
+                      std::to_string(dev_ + 1) + where(dev_);
+    if (host_ < dev_) {
+      why += ", which follows host bytes (chunk " + std::to_string(host_ + 1) + where(host_) +
+             ") that were never written; a direction marker may be wrong";
+    }
+    return why;
+  }
 
   /// Checks `bytes` against the recorded host stream.
   void write(std::span<const std::uint8_t> bytes, Timeout) {
@@ -256,6 +322,9 @@ class ReplayTransport {
   }
 
  private:
+  std::string where(std::size_t i) const {
+    return chunks_[i].line > 0 ? ", line " + std::to_string(chunks_[i].line) : std::string();
+  }
   std::size_t next(std::size_t i, bool to_device) const {
     while (i < chunks_.size() && chunks_[i].to_device != to_device) ++i;
     return i;
@@ -269,5 +338,25 @@ class ReplayTransport {
 };
 
 static_assert(Transport<ReplayTransport>);
+
+/// Why a replay that has stopped delivering frames did not play the whole recording, or ""
+/// when it did: recorded device bytes never read (see ReplayTransport::stall_reason), a last
+/// packet cut off (`unparsed_bytes` from the device's parser, e.g. DsaconDevice::
+/// unparsed_bytes), and the malformed line that ended the file (`file_error` from
+/// SessionPrefix). Tools report it and exit non-zero.
+inline std::string replay_shortfall(const ReplayTransport& replay, std::size_t unparsed_bytes,
+                                    const std::string& file_error = {}) {
+  std::string why = replay.stall_reason();
+  const auto add = [&why](const std::string& part) {
+    if (!why.empty()) why += "; ";
+    why += part;
+  };
+  if (unparsed_bytes > 0) {
+    add("the last packet is cut off (" + std::to_string(unparsed_bytes) +
+        " bytes of it were recorded)");
+  }
+  if (!file_error.empty()) add(file_error + " (the chunks before it were replayed)");
+  return why;
+}
 
 }  // namespace taxel::drivers

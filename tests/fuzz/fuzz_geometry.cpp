@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+// Fuzzes the geometry built from clouds: UniformGrid, Target (with its closest-point field),
+// Icp (both errors) and ObjectLibrary, on fuzzer-chosen clouds. The first byte picks how the
+// rest becomes coordinates: raw doubles (any finite value, huge ones included), small integers
+// on a millimetre lattice (duplicates and flat or collinear sets), or one axis only (collinear).
+// Every call must return or throw std::invalid_argument; answers must match brute force, and
+// every transform must be finite.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <taxel/index/brute_force.hpp>
+#include <taxel/index/uniform_grid.hpp>
+#include <taxel/registration.hpp>
+#include <vector>
+
+namespace {
+
+using taxel::Vec3d;
+
+std::vector<Vec3d> decode(const std::uint8_t* data, std::size_t size) {
+  std::vector<Vec3d> pts;
+  if (size == 0) return pts;
+  const int mode = data[0] % 3;
+  ++data;
+  --size;
+  if (mode == 0) {  // raw doubles: 24 bytes a point, non-finite ones dropped
+    for (std::size_t i = 0; i + 24 <= size && pts.size() < 96; i += 24) {
+      double v[3];
+      std::memcpy(v, data + i, sizeof v);
+      if (std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2])) {
+        pts.emplace_back(v[0], v[1], v[2]);
+      }
+    }
+  } else if (mode == 1) {  // a 1 mm lattice of 16 steps per axis: duplicates, planes, lines
+    for (std::size_t i = 0; i + 3 <= size && pts.size() < 96; i += 3) {
+      pts.emplace_back(1e-3 * (data[i] % 16), 1e-3 * (data[i + 1] % 16), 1e-3 * (data[i + 2] % 16));
+    }
+  } else {  // one axis: collinear
+    for (std::size_t i = 0; i < size && pts.size() < 96; ++i) {
+      pts.emplace_back(1e-3 * data[i], 0.0, 0.0);
+    }
+  }
+  return pts;
+}
+
+void check_against_brute(const taxel::registration::Target<double>& t,
+                         const std::vector<Vec3d>& pts, const Vec3d& q) {
+  taxel::index::BruteForce<double> brute;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    brute.insert(static_cast<taxel::index::PointId>(i), pts[i]);
+  }
+  for (const double r : {1e-3, 1.0, std::numeric_limits<double>::infinity()}) {
+    const auto a = t.nearest_within(q, r);
+    const auto b = brute.nearest_within(q, r);
+    if (a.has_value() != b.has_value()) std::abort();
+    if (a && a->squared_distance != b->squared_distance) std::abort();
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  namespace tr = taxel::registration;
+  const std::vector<Vec3d> pts = decode(data, size);
+  if (pts.empty()) return 0;
+  try {
+    const taxel::index::UniformGrid<double> grid(pts);
+    const auto hit = grid.nearest_within(pts.front(), 0.0);
+    if (!hit || hit->squared_distance != 0.0) std::abort();
+  } catch (const std::invalid_argument&) {
+    return 0;  // a cloud too wide to grid; Target would refuse it the same way
+  }
+  taxel::PointCloud<double> cloud;
+  cloud.points = pts;
+  try {
+    const tr::Target<double> target(cloud,
+                                    tr::TargetConfig{.field_cell = 1e-3, .field_max_cells = 512});
+    check_against_brute(target, pts, pts.back() + Vec3d(1e-4, -2e-4, 3e-4));
+    check_against_brute(target, pts, Vec3d(0, 0, 0));
+
+    // ICP of the cloud onto itself from a small offset: whatever the status, finite numbers.
+    Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+    start.translation() = Vec3d(1e-3, 0, -1e-3);
+    const std::span<const Vec3d> source(pts);
+    const tr::IcpResult a = tr::Icp<tr::PointToPlane>({.max_iterations = 10}).align(target, source, start);
+    const tr::IcpResult b = tr::Icp<tr::PointToPoint>({.max_iterations = 10}).align(target, source, start);
+    for (const auto* r : {&a, &b}) {
+      if (!r->transform.matrix().allFinite() || !std::isfinite(r->rmse)) std::abort();
+    }
+
+    tr::LibraryConfig lc;
+    lc.rotation_starts = 2;
+    tr::ObjectLibrary<double> library(lc);
+    library.add("model", cloud, {.field_max_cells = 512});
+    const tr::ObjectRecognition rec = library.recognize(cloud);
+    for (const auto& m : rec.ranking) {
+      if (!m.transform.matrix().allFinite() || std::isnan(m.score)) std::abort();
+    }
+  } catch (const std::invalid_argument&) {
+  }
+  return 0;
+}
