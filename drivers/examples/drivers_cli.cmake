@@ -51,3 +51,37 @@ expect("${err}" "differs from the recording at chunk 1, byte 3")
 file(WRITE "${WORK_DIR}/bad_poses.csv" "time_ms,matrix,x,y,z,qw,qx,qy,qz\n0,1,0,0,0,1,0,0,0\n")
 run_tool("${STREAM}" 1 --replay s.session --poses bad_poses.csv)
 expect("${err}" "bad_poses.csv:2: matrix 1.000000, expected 0")
+
+# Lost writes are errors: the poses file and the session on a device that is full, standard
+# output on /dev/full; a session file that cannot be written keeps the previous one.
+run_tool("${RECORD}" 1 --emulate sphere --grasps 1 --period-ms 5 --poses /dev/full s2.session)
+expect("${err}" "/dev/full.*No space left on device")
+file(WRITE "${WORK_DIR}/keep.session" "previous\n")
+execute_process(COMMAND sh -c "trap '' XFSZ; ulimit -f 0; exec \"$0\" \"$@\"" "${RECORD}"
+                        --emulate sphere --grasps 1 --period-ms 5 keep.session
+                WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "keep.session.*File too large")
+  message(FATAL_ERROR "taxel-record on a full disk: exit ${rc}\n${err}")
+endif()
+file(READ "${WORK_DIR}/keep.session" kept)
+if(NOT kept STREQUAL "previous\n")
+  message(FATAL_ERROR "taxel-record on a full disk replaced the previous session")
+endif()
+execute_process(COMMAND "${STREAM}" --replay s.session --out out3 WORKING_DIRECTORY "${WORK_DIR}"
+                RESULT_VARIABLE rc OUTPUT_FILE /dev/full ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "cannot write standard output")
+  message(FATAL_ERROR "07_stream_fusion >/dev/full: exit ${rc}\n${err}")
+endif()
+execute_process(COMMAND "${RECORD}" --emulate sphere --grasps 1 --period-ms 5 s3.session
+                WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE rc OUTPUT_FILE /dev/full
+                ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "cannot write standard output")
+  message(FATAL_ERROR "taxel-record >/dev/full: exit ${rc}\n${err}")
+endif()
+
+# A damaged session replays what it can and exits 1 with the reason.
+file(READ "${WORK_DIR}/s.session" whole)
+file(WRITE "${WORK_DIR}/odd.session" "${whole}99.0 < abc\n")
+run_tool("${STREAM}" 1 --replay odd.session --out out4)
+expect("${out}" "frames 60 ")
+expect("${err}" "odd.session:[0-9]+: hex bytes must be .*the cloud holds the frames before it")

@@ -16,6 +16,7 @@ namespace taxel::image {
 /// Connected-component labelling workspace. Labels are assigned in raster order (row by row)
 /// from 1; MATLAB numbers in column order, so compare region properties, not label numbers.
 /// Reusing one object for images of the same size allocates nothing.
+/// Not thread-safe (a reused workspace); one per thread.
 class Components {
  public:
   Components() = default;

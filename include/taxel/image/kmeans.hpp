@@ -47,6 +47,7 @@ struct KMeans1dResult : Outcome {
 /// D_c(j) = min_i D_{c-1}(i-1) + SSE(i..j) by divide and conquer over monotone split points
 /// (O(k m log m) for m distinct values; the last layer is a single O(m) scan). Buffers are kept
 /// between calls, so fitting images of the same size allocates nothing after the first call.
+/// Not thread-safe (a reused workspace); one per thread.
 class KMeans1d {
  public:
   /// `k` clusters, 1 <= k <= 255. Throws std::invalid_argument otherwise.

@@ -81,6 +81,8 @@ struct Recognition : Outcome {
 /// taxel reads them as the three largest HPRs (8-connected, after small-region removal), in
 /// descending area, zero-padded when fewer exist. Gradient means are over each region's contour
 /// pixels (bwperim, 4-connected).
+/// Not thread-safe: `recognize` reuses the workspace it owns; use one Recognizer per thread
+/// (copies are independent).
 template <EdgeDecider Decider = GradientThreshold, FeatureClassifier Classifier = NoClassifier>
 class Recognizer {
  public:

@@ -75,6 +75,7 @@ struct RecEdgelessConfig {
 };
 
 /// Reconstruction workspace; reusing it for images of one size allocates nothing.
+/// Not thread-safe (a reused workspace); one per thread.
 class Reconstructor {
  public:
   Reconstructor(RecEdgedConfig edged = {}, RecEdgelessConfig edgeless = {}, Eigen::Index rows = 32,

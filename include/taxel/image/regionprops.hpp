@@ -56,6 +56,7 @@ struct RegionProps {
 /// with the Vossepoel-Smeulders coefficients: 0.980 per axis step, 1.406 per diagonal step,
 /// -0.091 per change of step type; a single pixel has perimeter 0. Holes are not counted. For a
 /// union of several components the lengths add.
+/// Not thread-safe (a reused workspace); one per thread.
 class RegionAnalyzer {
  public:
   explicit RegionAnalyzer(RegionPropsOptions opt = {}, Eigen::Index rows = 32,

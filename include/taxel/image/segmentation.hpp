@@ -52,6 +52,7 @@ struct Segmentation : Outcome {
 };
 
 /// Segmentation workspace; reusing it for images of one size allocates nothing.
+/// Not thread-safe (a reused workspace); one per thread.
 class Segmenter {
  public:
   /// Throws std::invalid_argument on a bad configuration, naming the field.

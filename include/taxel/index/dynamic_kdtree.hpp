@@ -24,6 +24,7 @@ namespace taxel::index {
 /// forest is rebuilt from the live points when dead slots outnumber them. Internal slots map
 /// back to ids, so answers are exact and use taxel's tie order.
 /// Complexity: insert/move O(log^2 n) amortised; queries O(log^2 n). Memory: see memory_bytes().
+/// Not thread-safe for concurrent writes; concurrent const queries are safe.
 template <Scalar S>
 class DynamicKdTree {
  public:

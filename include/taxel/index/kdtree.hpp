@@ -137,6 +137,7 @@ struct IdentityIds {
 /// Build O(n log n); queries O(log n) expected. Exact, with taxel's tie order. Use it for
 /// clouds that do not change (ICP targets, models); see DynamicKdTree for incremental use.
 /// Const queries may run concurrently.
+/// Immutable after construction: concurrent queries are safe.
 template <Scalar S>
 class KdTree {
  public:

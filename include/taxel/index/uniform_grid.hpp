@@ -25,6 +25,7 @@ namespace taxel::index {
 
 /// Static exact index on a uniform grid; point i has id i. Models SpatialIndex.
 /// Const queries may run concurrently.
+/// Immutable after construction: concurrent queries are safe.
 template <Scalar S>
 class UniformGrid {
  public:

@@ -35,6 +35,7 @@ namespace taxel::index {
 /// the pools included). No allocation in `move` within a cell or in `nearest_within`.
 /// Coordinates beyond 2^30 cells from the origin share the outermost cells (still exact,
 /// slower). Const queries may run concurrently; writes may not.
+/// Not thread-safe for concurrent writes; concurrent const queries are safe.
 template <Scalar S>
 class VoxelHash {
  public:

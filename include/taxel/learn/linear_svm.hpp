@@ -51,6 +51,8 @@ struct LinearSvmTrainInfo {
 
 /// A linear SVM classifier: `decision_k(x) = w_k'x + b_k`, label = argmax (one-vs-rest), or
 /// the sign of the single decision value for two classes. Models the Classifier concept.
+/// Thread-safety: a trained model's const members (predict, decision, save) may run on
+/// several threads at once; `fit` and `load` must not overlap with any other call.
 class LinearSvm {
  public:
   /// Throws std::invalid_argument for C or eps not positive and finite, a non-finite bias or

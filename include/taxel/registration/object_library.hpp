@@ -98,6 +98,8 @@ struct ObjectRecognition : Outcome {
 };
 
 /// Named object models, each preprocessed once into a Target.
+/// Thread-safety: `recognize` is const and keeps its state on the stack, so several
+/// threads may recognise at once; `add` must not overlap with any other call.
 template <Scalar S = double>
 class ObjectLibrary {
  public:

@@ -46,6 +46,8 @@ struct TargetConfig {
 
 /// A model prepared for registration. Normals estimated by PCA are oriented away from the
 /// centroid (right for convex objects; point-to-plane ICP does not depend on the sign).
+/// Immutable after construction (every member function is const), so one Target may serve
+/// any number of threads.
 template <Scalar S = double>
 class Target {
  public:
