@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// ICP and recognition (REFERENCES.md section 5 and DESIGN.md performance targets):
+// ICP and recognition (the targets and peer figures are in docs/performance.md):
 //  - a 2000-point partial tactile cloud (5 patches of 15 mm radius, sigma 1 mm) against a
 //    10000-point 80 x 60 x 40 mm box model, starts within 10 deg / 5 mm, 30 seeded trials
 //    cycled; point-to-plane (target <= 3 ms per alignment at <= 0.25 mm RMS pose error) and

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// 06_recognition_study: reruns the second paper's recognition study (PAPERS.md 2.2-2.4) on
+// 06_recognition_study: reruns the second paper's recognition study on
 // SYNTHETIC palm-grasp pressure images from taxel::sim::PalmGraspSynth:
 //  - Table 2: conventional (11 regional descriptors) vs hybrid (1024 gradient magnitudes of the
 //    reconstruction + 11) recognition with a linear SVM and 5-fold cross-validation;
@@ -151,7 +151,7 @@ tl::Dataset hybrid_features(const std::vector<ts::PalmGraspSample>& data, const 
 }
 
 // Accuracy at each SNR of white noise on the test features; each fold's model is trained once
-// on clean features and tested at every SNR (noise on test data only, PAPERS.md 2.6 #11).
+// on clean features and tested at every SNR (noise on test data only; the paper does not say which side gets it).
 // The noise goes on the raw feature vector (`raw`) or on the vector after the training folds'
 // z-scoring (`standardised`, every feature at unit scale).
 struct SnrCurves {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <taxel/io/ply.hpp>
@@ -153,12 +154,18 @@ int main(int argc, char** argv) {
     args.fail(e.what(), 1);
   }
   tr::IcpResult r;
+  std::optional<tr::Target<double>> tg_storage;
+  try {  // a model Target refuses (points too far apart to grid, bad normals) is bad data
+    tg_storage.emplace(std::move(target.cloud),
+                       tr::TargetConfig{.normal_neighbors = opt.normal_neighbors});
+  } catch (const std::invalid_argument& e) {
+    args.fail(opt.inputs[1] + ": " + e.what(), 1);
+  }
+  const tr::Target<double>& tg = *tg_storage;
   try {
-    const tr::Target<double> tg(std::move(target.cloud),
-                                tr::TargetConfig{.normal_neighbors = opt.normal_neighbors});
     r = opt.point_to_point ? dispatch<tr::PointToPoint>(opt, tg, source.cloud)
                            : dispatch<tr::PointToPlane>(opt, tg, source.cloud);
-  } catch (const std::invalid_argument& e) {  // a configuration Icp or Target refuses
+  } catch (const std::invalid_argument& e) {  // a configuration Icp refuses
     args.fail(e.what());
   }
   for (int row = 0; row < 4; ++row) {

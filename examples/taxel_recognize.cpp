@@ -7,6 +7,7 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <taxel/io/ply.hpp>
@@ -89,14 +90,23 @@ int main(int argc, char** argv) {
   }
 
   tr::ObjectRecognition r;
+  std::optional<tr::ObjectLibrary<double>> lib;
   try {
-    tr::ObjectLibrary<double> lib(cfg);
-    for (const auto& m : models) lib.add(m.stem().string(), taxel::io::read_ply(m.string()).cloud);
-    r = lib.recognize(taxel::io::read_ply(inputs[0]).cloud);
+    lib.emplace(cfg);
+  } catch (const std::invalid_argument& e) {  // the options
+    die(e.what(), 2);
+  }
+  try {
+    for (const auto& m : models) {
+      try {
+        lib->add(m.stem().string(), taxel::io::read_ply(m.string()).cloud);
+      } catch (const std::invalid_argument& e) {  // a model the library refuses: bad data
+        die(m.string() + ": " + e.what(), 1);
+      }
+    }
+    r = lib->recognize(taxel::io::read_ply(inputs[0]).cloud);
   } catch (const taxel::IoError& e) {
     die(e.what(), 1);
-  } catch (const std::invalid_argument& e) {
-    die(e.what(), 2);
   }
   if (!r.ok()) die(inputs[0] + ": " + r.message, 1);
 

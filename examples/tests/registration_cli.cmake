@@ -57,3 +57,26 @@ expect_one_line("${err}")
 file(MAKE_DIRECTORY "${WORK_DIR}/empty")
 run_tool("${RECOGNIZE}" 1 rec/clouds/cube-50.ply empty)
 expect("${err}" "no .ply files")
+
+# Hostile models: coordinates whose extent overflows (this used to hang) and a property named
+# twice are bad data (exit 1), refused at once; float coordinates near the float limit (an int
+# overflow once aborted) are a legal, if useless, model.
+set(head "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\nend_header\n")
+file(WRITE "${WORK_DIR}/wide.ply" "${head}-1e308 0 0\n1e308 0 0\n0 1 0\n0 0 1\n")
+run_tool("${ICP}" 1 rec/clouds/cube-50.ply wide.ply)
+expect("${err}" "wide.ply: UniformGrid: the points span")
+expect_one_line("${err}")
+file(MAKE_DIRECTORY "${WORK_DIR}/wide_models")
+file(COPY "${WORK_DIR}/wide.ply" DESTINATION "${WORK_DIR}/wide_models")
+run_tool("${RECOGNIZE}" 1 rec/clouds/cube-50.ply wide_models)
+expect("${err}" "wide.ply: UniformGrid")
+string(REPLACE "double" "float" fhead "${head}")
+file(WRITE "${WORK_DIR}/huge_float.ply" "${fhead}-1e38 0 0\n1e38 0 0\n0 1e38 0\n0 0 -1e38\n")
+run_tool("${RECOGNIZE}" 0 rec/clouds/cube-50.ply huge_float.ply)
+expect("${out}" "best: unknown")
+file(WRITE "${WORK_DIR}/twice.ply" "${head}property double x\n")
+string(REPLACE "property double z\nend_header\nproperty double x\n"
+       "property double z\nproperty double x\nend_header\n1 2 3 4\n" twice "${head}property double x\n")
+file(WRITE "${WORK_DIR}/twice.ply" "${twice}")
+run_tool("${ICP}" 1 rec/clouds/cube-50.ply twice.ply)
+expect("${err}" "twice.ply:7: element 'vertex' has two properties named 'x'")

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Tests of taxel::image against MATLAB's published regionprops values (REFERENCES.md section 1),
+// Tests of taxel::image against MATLAB's published regionprops values (MathWorks' documentation),
 // the Sobel test vector, exhaustive k-means, brute-force flood fills and closed forms.
 #include <algorithm>
 #include <catch2/catch.hpp>

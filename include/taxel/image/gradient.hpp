@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Sobel gradients as MATLAB's imgradientxy / imgradient (REFERENCES.md section 2): correlation
+// Sobel gradients as MATLAB's imgradientxy / imgradient: correlation
 // with the Sobel kernels, replicate border; Gy > 0 when intensity grows downwards;
 // magnitude = hypot(Gx, Gy), direction = atan2(-Gy, Gx) in degrees. Also the contour pixels of a
 // region (MATLAB's bwperim, 4-connected).

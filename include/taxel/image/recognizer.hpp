@@ -76,7 +76,7 @@ struct Recognition : Outcome {
 
 /// Runs the second paper's chain on images of a fixed size.
 ///
-/// Features 15-23 (PAPERS.md 2.6 #3): the paper lists three indices for each of "area",
+/// Features 15-23: the paper lists three indices for each of "area",
 /// "average gradient magnitude" and "average gradient angle" of "the HPR having maximum area";
 /// taxel reads them as the three largest HPRs (8-connected, after small-region removal), in
 /// descending area, zero-padded when fewer exist. Gradient means are over each region's contour

@@ -2,8 +2,9 @@
 // 3-D shape from one pressure image (second paper, step 6): RecEdged, a row-scan state machine
 // for objects with edges, and RecEdgeless, background cropping + finger-gap healing + column-wise
 // polynomial fit for planar and cylindrical objects. Both return an M x N height map. The paper
-// lost the figures that held both algorithms; every open choice is an option here, with the
-// defaults PAPERS.md 2.3 (steps 6a, 6b) and 2.6 (#5-#7) argue for.
+// lost the figures that held both algorithms; every open choice (the edge condition, whether a
+// step lifts the whole row, the step constant K, the polynomial degree, the gap-healing rule) is
+// an option here, with defaults chosen to give a raised plateau for two-edged objects.
 #pragma once
 
 #include <Eigen/Cholesky>

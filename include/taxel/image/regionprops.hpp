@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Region descriptors with MATLAB `regionprops` conventions (REFERENCES.md section 1): pixel
+// Region descriptors with MATLAB `regionprops` conventions (as MathWorks documents them): pixel
 // centres at integer coordinates, x = column, y = row, 1-based by default; second moments with
 // y pointing up and +1/12 for each pixel's extent; ConvexArea as a pixel count of the hull of
 // the pixels' edge midpoints, rasterised with poly2mask's 5x5 sub-pixel rule.

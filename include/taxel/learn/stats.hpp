@@ -139,7 +139,7 @@ inline FiveByTwoResult five_by_two_t_test(const FiveByTwoDifferences& diff, doub
 
 /// Where feature noise goes in an evaluation.
 enum class NoiseTarget {
-  test_only,  ///< the classifier trains on clean features (default, PAPERS.md 2.6 #11)
+  test_only,  ///< the classifier trains on clean features (default; the second paper does not say)
   both,       ///< training and test features are both noisy
 };
 

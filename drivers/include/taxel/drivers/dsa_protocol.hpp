@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The Weiss DSACON32m tactile controller protocol (as SCHUNK's SDHLibrary speaks it, files
-// dsa.h / dsa.cpp / crc.cpp; REFERENCES.md section 6): packet framing, the CRC, command
+// dsa.h, dsa.cpp and crc.cpp): packet framing, the CRC, command
 // encoders, an incremental parser that resynchronises on garbage, and typed replies. Pure
 // byte handling: no I/O, no device code.
 //
