@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <taxel/version.hpp>
 
 namespace taxel_cli {
 
@@ -30,6 +31,16 @@ inline void check_stdout_at_exit(const char* tool) {
       std::_Exit(1);
     }
   });
+}
+
+/// Prints "<tool> (taxel) <version>" and exits 0 when any argument is `--version`.
+inline void print_version_if_asked(const char* tool, int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string_view(argv[i]) == "--version") {
+      std::printf("%s (taxel) %s\n", tool, TAXEL_VERSION_STRING);
+      std::exit(0);
+    }
+  }
 }
 
 /// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).

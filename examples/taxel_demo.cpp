@@ -471,6 +471,7 @@ void session_section(const fs::path& out, Page& page) {
 
 int main(int argc, char** argv) try {
   taxel_cli::check_stdout_at_exit("taxel-demo");
+  taxel_cli::print_version_if_asked("taxel-demo", argc, argv);
   bool quick = false;
   fs::path out = "taxel-demo-output";
   for (int i = 1; i < argc; ++i) {
@@ -479,7 +480,7 @@ int main(int argc, char** argv) try {
       quick = true;
     } else if (a == "-h" || a == "--help") {
       std::puts(
-          "usage: taxel-demo [--quick] [OUTPUT-FOLDER]\n"
+          "usage: taxel-demo [--quick] [--version] [OUTPUT-FOLDER]\n"
           "Runs taxel end to end on simulated data and writes tables, PLY clouds,\n"
           "pictures and an index.html into OUTPUT-FOLDER (default taxel-demo-output).");
       return 0;

@@ -43,6 +43,7 @@ options:
   --degree D            RecEdgeless polynomial degree (default 2)
   -o FILE               write to FILE instead of standard output
   -h, --help            show this help
+  --version             show taxel's version
 )";
 
 struct Options {
@@ -181,6 +182,7 @@ std::string describe_libsvm(const Options& opt) {
 
 int main(int argc, char** argv) try {
   taxel_cli::check_stdout_at_exit("taxel-describe");
+  taxel_cli::print_version_if_asked("taxel-describe", argc, argv);
   const Options opt = parse(argc, argv);
   // The whole output is built first and written once: a failure leaves no partial output.
   std::string out;

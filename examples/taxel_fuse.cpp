@@ -71,6 +71,7 @@ readings (--readings, --session):
   --sigma-tilt S    pad rotation noise from the kinematics [rad] (default 0.02)
   --frame-rate F    frames per second, for poses without a time (default 1000) (default binary little-endian)
   -h, --help        show this help
+  --version         show taxel's version
 
 Prints the counts (contacts, added, fused, rejected by reason, points, points written) and the
 time per contact.
@@ -210,6 +211,7 @@ std::string session_contacts(const Options& o, const taxel::sensor::ContactOptio
 
 int main(int argc, char** argv) {
   taxel_cli::check_stdout_at_exit("taxel-fuse");
+  taxel_cli::print_version_if_asked("taxel-fuse", argc, argv);
   taxel_cli::Args args("taxel-fuse", argc, argv);
   constexpr double kInf = std::numeric_limits<double>::infinity();
   Options o;

@@ -38,6 +38,7 @@ options:
   --normal-neighbors K  neighbours of the PCA normals (default 12)
   -o FILE               also write the aligned source as PLY
   -h, --help            show this help
+  --version             show taxel's version
 
 Exit status: 0 when ICP ran (whatever its status), 1 for unreadable input, 2 for bad options.
 )usage";
@@ -144,6 +145,7 @@ tr::IcpResult dispatch(const Options& o, const tr::Target<double>& target,
 
 int main(int argc, char** argv) {
   taxel_cli::check_stdout_at_exit("taxel-icp");
+  taxel_cli::print_version_if_asked("taxel-icp", argc, argv);
   taxel_cli::Args args("taxel-icp", argc, argv);
   const Options opt = parse(args);
   taxel::io::PlyData source, target;

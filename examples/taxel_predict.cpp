@@ -22,6 +22,7 @@ options:
 -q : quiet mode (no outputs)
 --max-values n : largest dense data set read, samples x features (default 16777216)
 -h, --help : show this help
+--version : show the version
 
 model_file is a LIBLINEAR text model (from taxel-train or LIBLINEAR's train, any classification
 solver). As LIBLINEAR does, features beyond the model's nr_feature are ignored. Prints
@@ -37,6 +38,7 @@ solver). As LIBLINEAR does, features beyond the model's nr_feature are ignored. 
 
 int main(int argc, char** argv) {
   taxel_cli::check_stdout_at_exit("taxel-predict");
+  taxel_cli::print_version_if_asked("taxel-predict", argc, argv);
   try {
     bool quiet = false;
     std::vector<std::string> files;

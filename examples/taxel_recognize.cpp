@@ -35,6 +35,7 @@ options:
   --starts N         cube-rotation starts, 0..24 (default 24)
   --format text|json (default text)
   -h, --help         show this help
+  --version          show taxel's version
 
 Exit status: 0 when the cloud was ranked, 1 for unreadable input, 2 for bad options.
 )usage";
@@ -43,6 +44,7 @@ Exit status: 0 when the cloud was ranked, 1 for unreadable input, 2 for bad opti
 
 int main(int argc, char** argv) {
   taxel_cli::check_stdout_at_exit("taxel-recognize");
+  taxel_cli::print_version_if_asked("taxel-recognize", argc, argv);
   taxel_cli::Args args("taxel-recognize", argc, argv);
   const auto die = [&](const std::string& why, int code = 2) { args.fail(why, code); };
   constexpr double kInf = std::numeric_limits<double>::infinity();

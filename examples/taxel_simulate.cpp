@@ -64,6 +64,7 @@ options:
   --readings F.npy   also write the readings of the frames that gave the contacts
   --poses F.csv      also write the pads' believed poses (frame,pad,x,y,z,qw,qx,qy,qz,time)
   -h, --help         show this help
+  --version          show taxel's version
 
 Exit status: 0 on success, 1 for unreadable or unwritable files, 2 for bad options.
 )usage";
@@ -177,6 +178,7 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
 
 int main(int argc, char** argv) {
   taxel_cli::check_stdout_at_exit("taxel-simulate");
+  taxel_cli::print_version_if_asked("taxel-simulate", argc, argv);
   taxel_cli::Args args("taxel-simulate", argc, argv);
   constexpr double kInf = std::numeric_limits<double>::infinity();
   Options o;

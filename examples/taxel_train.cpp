@@ -33,6 +33,7 @@ options:
 --max-iter n : outer iterations per binary problem (default 1000, as LIBLINEAR 2.3)
 --max-values n : largest dense data set read, samples x features (default 16777216)
 -h, --help : show this help
+--version : show the version
 
 The model file is LIBLINEAR's text format (default: <training_set_file basename>.model in the
 current directory); LIBLINEAR's predict and taxel-predict both read it.
@@ -62,6 +63,7 @@ std::string basename(const std::string& path) {
 
 int main(int argc, char** argv) {
   taxel_cli::check_stdout_at_exit("taxel-train");
+  taxel_cli::print_version_if_asked("taxel-train", argc, argv);
   try {
     tl::LinearSvmConfig cfg;
     int folds = 0;

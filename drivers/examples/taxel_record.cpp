@@ -43,6 +43,7 @@ options:
   --period-ms P      with --emulate: frame period (default 33.3, about 30 frames/s)
   --seed S           with --emulate (default 1)
   -h, --help         show this help
+  --version          show taxel's version
 
 Exit status: 0 on success, 1 when the device fails or a file cannot be written, 2 for bad
 options.
@@ -132,6 +133,7 @@ int emulate(const Shape& shape, const Options& o, const taxel_cli::Args& args) {
 
 int main(int argc, char** argv) {
   taxel_cli::check_stdout_at_exit("taxel-record");
+  taxel_cli::print_version_if_asked("taxel-record", argc, argv);
   taxel_cli::Args args("taxel-record", argc, argv);
   Options o;
   std::string_view a;

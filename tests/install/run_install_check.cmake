@@ -24,6 +24,25 @@ foreach(f share/cmake/taxel/taxelConfig.cmake share/cmake/taxel/taxelConfigVersi
   endif()
 endforeach()
 
+# The tools, when installed, run from the prefix alone (a fresh folder, nothing else on PATH).
+if(TOOLS)
+  foreach(tool taxel-simulate taxel-fuse taxel-icp taxel-recognize taxel-describe taxel-train
+               taxel-predict)
+    execute_process(COMMAND "${prefix}/bin/${tool}" --version RESULT_VARIABLE rc
+                    OUTPUT_VARIABLE out)
+    if(NOT rc EQUAL 0 OR NOT out MATCHES "^${tool} \\(taxel\\) [0-9]+\\.[0-9]+\\.[0-9]+\n$")
+      message(FATAL_ERROR "installed ${tool} --version: exit ${rc}, '${out}'")
+    endif()
+  endforeach()
+  file(MAKE_DIRECTORY "${WORK_DIR}/tools")
+  run(${CMAKE_COMMAND} -E chdir "${WORK_DIR}/tools"
+      "${prefix}/bin/taxel-simulate" --shape box --contacts 2000 contacts.csv truth.ply)
+  run(${CMAKE_COMMAND} -E chdir "${WORK_DIR}/tools"
+      "${prefix}/bin/taxel-fuse" contacts.csv cloud.ply)
+  run(${CMAKE_COMMAND} -E chdir "${WORK_DIR}/tools"
+      "${prefix}/bin/taxel-icp" cloud.ply truth.ply)
+endif()
+
 set(consumers "${TAXEL_SOURCE_DIR}/tests/install")
 foreach(kind cmake pkgconfig subdir)
   set(build "${WORK_DIR}/build_${kind}")
