@@ -111,14 +111,23 @@ struct Surfel {
     const Vec3<S> nm = s.normal_sum.normalized();
     const S cos_c = nc.dot(nm);
     if (!(cos_c >= cos_max_)) return kalman_.fuse(s.kalman, c, n);
-    // Turn the covariance onto the mean normal: Q = I + [v]x + [v]x^2 / (1 + c), v = nc x nm.
+    // Turn the covariance onto the mean normal: Q = I + [v]x + [v]x^2 / (1 + c), v = nc x nm,
+    // with [v]x^2 = v v' - |v|^2 I written out, and only the upper triangle of Q C Q' computed
+    // (it is symmetric by construction).
     const Vec3<S> v = nc.cross(nm);
-    Mat3<S> vx;
-    vx << S(0), -v.z(), v.y(), v.z(), S(0), -v.x(), -v.y(), v.x(), S(0);
-    const Mat3<S> q = Mat3<S>::Identity() + vx + (vx * vx) / (S(1) + cos_c);
+    const S k = S(1) / (S(1) + cos_c);
+    const S diag = S(1) - k * v.squaredNorm();
+    Mat3<S> q;
+    q << diag + k * v.x() * v.x(), k * v.x() * v.y() - v.z(), k * v.x() * v.z() + v.y(),
+        k * v.y() * v.x() + v.z(), diag + k * v.y() * v.y(), k * v.y() * v.z() - v.x(),
+        k * v.z() * v.x() - v.y(), k * v.z() * v.y() + v.x(), diag + k * v.z() * v.z();
+    const Mat3<S> qc = q * c.covariance;
     Contact<S> turned = c;
-    turned.covariance = q * c.covariance * q.transpose();
-    turned.covariance = S(0.5) * (turned.covariance + turned.covariance.transpose()).eval();
+    for (int i = 0; i < 3; ++i) {
+      for (int j = i; j < 3; ++j) {
+        turned.covariance(i, j) = turned.covariance(j, i) = qc.row(i).dot(q.row(j));
+      }
+    }
     if (!kalman_.fuse(s.kalman, turned, n)) return false;
     // Curvature sums in the frame of the first contact.
     const Vec3<S> t2 = s.n0.cross(s.t1);
