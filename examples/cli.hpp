@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -48,15 +49,29 @@ class Args {
  public:
   Args(const char* tool, int argc, char** argv) : tool_(tool), argc_(argc), argv_(argv) {}
 
-  /// The next argument, or false at the end.
+  /// The next argument, or false at the end. `--name=value` comes back as `--name`, its value
+  /// kept for value(); an option that takes no value fails when given one.
   bool next(std::string_view& arg) {
+    if (inline_value_) fail(std::string(current_) + " takes no value");
     if (i_ + 1 >= argc_) return false;
     arg = current_ = argv_[++i_];
+    if (arg.size() > 2 && arg.substr(0, 2) == "--") {
+      if (const auto eq = arg.find('='); eq != std::string_view::npos) {
+        inline_value_ = arg.substr(eq + 1);
+        arg = current_ = arg.substr(0, eq);
+      }
+    }
     return true;
   }
 
-  /// The value of the current option (the next argument); fails when there is none.
+  /// The value of the current option (after '=', or the next argument); fails when there is
+  /// none.
   std::string_view value() {
+    if (inline_value_) {
+      const std::string_view v = *inline_value_;
+      inline_value_.reset();
+      return v;
+    }
     if (i_ + 1 >= argc_) fail(std::string(current_) + " needs a value");
     return argv_[++i_];
   }
@@ -86,6 +101,7 @@ class Args {
   char** argv_;
   int i_ = 0;
   std::string_view current_;
+  std::optional<std::string_view> inline_value_;  // from --name=value, until value() takes it
 };
 
 /// The options every study example takes: --quick, --out DIR, -h/--help (which prints `usage`

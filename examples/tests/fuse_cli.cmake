@@ -218,3 +218,13 @@ file(WRITE "${WORK_DIR}/cut.session" "${cut}")
 run_tool("${TOOL}" 1 --session cut.session cut.ply)
 expect("${out}" "session 77 frames")
 expect("${err}" "the last packet is cut off")
+
+# --name=value as well as --name value; a flag given a value is refused.
+run_tool("${TOOL}" 0 --radius=0.004 --policy=kalman contacts.csv eq.ply)
+expect("${out}" "written [1-9]")
+run_tool("${TOOL}" 2 --ascii=yes contacts.csv eq.ply)
+expect("${err}" "--ascii takes no value")
+run_tool("${TOOL}" 2 --radius= contacts.csv eq.ply)
+expect("${err}" "--radius")
+run_tool("${TOOL}" 0 --version)
+expect("${out}" "^taxel-fuse \\(taxel\\) [0-9]+\\.[0-9]+\\.[0-9]+\n$")
