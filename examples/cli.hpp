@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -42,6 +43,38 @@ inline void print_version_if_asked(const char* tool, int argc, char** argv) {
       std::exit(0);
     }
   }
+}
+
+/// The largest side of the bounding box of `points` (anything with .x() .y() .z()); 0 when
+/// there are none. Non-finite points are skipped.
+template <class Points>
+double largest_extent(const Points& points) {
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (const auto& p : points) {
+    const double v[3] = {double(p.x()), double(p.y()), double(p.z())};
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = v[a] < lo[a] ? v[a] : lo[a];
+      hi[a] = v[a] > hi[a] ? v[a] : hi[a];
+    }
+  }
+  double e = 0.0;
+  for (int a = 0; a < 3; ++a) e = hi[a] - lo[a] > e ? hi[a] - lo[a] : e;
+  return e;
+}
+
+/// Tactile objects are centimetres across and taxel works in metres: coordinates spanning more
+/// than `limit` (1 m), up to 10 km, look like millimetres. Prints "<tool>: warning: <what> spans
+/// <e> along one axis: its coordinates look like millimetres; taxel uses metres: --scale 0.001" and
+/// returns true when they do.
+inline bool warn_if_millimetres(const char* tool, const std::string& what, double extent,
+                                double limit = 1.0) {
+  if (!(extent > limit) || !(extent <= 1e4 * limit)) return false;  // larger is not millimetres
+  std::fprintf(stderr,
+               "%s: warning: %s spans %.4g along one axis: its coordinates look like "
+               "millimetres; taxel uses metres: --scale 0.001\n",
+               tool, what.c_str(), extent);
+  return true;
 }
 
 /// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).

@@ -59,7 +59,9 @@ options:
   --process-noise Q surfel, kalman: process noise [m] per update (default 0)
   --min-observations N   keep only points with at least N contacts (default 1: all)
   --max-sigma S     keep only points whose largest standard deviation is at most S [m]
-  --ascii           write ASCII PLY
+  --ascii           write ASCII PLY (default binary little-endian)
+  --scale F         multiply the contacts' positions by F (covariances by F^2): --scale 0.001
+                    for a CSV in millimetres (CONTACTS.csv only)
 readings (--readings, --session):
   --per-pad         one contact per pad and frame (default: one per active tactel)
   --pitch P         tactel pitch [m] (default 0.0034; --readings only)
@@ -69,7 +71,7 @@ readings (--readings, --session):
   --sigma-normal S  depth noise of a reading [m] (default 0.0003)
   --sigma-position S  pad position noise from the kinematics [m] (default 0.0002)
   --sigma-tilt S    pad rotation noise from the kinematics [rad] (default 0.02)
-  --frame-rate F    frames per second, for poses without a time (default 1000) (default binary little-endian)
+  --frame-rate F    frames per second, for poses without a time (default 1000)
   -h, --help        show this help
   --version         show taxel's version
 
@@ -91,6 +93,7 @@ struct Options {
   double frame_rate = 1000.0;
   taxel::sensor::SensorModel model;
   double max_sigma = std::numeric_limits<double>::infinity();
+  double scale = 1.0;
   std::vector<std::string> files;
 };
 
@@ -124,6 +127,13 @@ int fuse(const Options& o, typename Cloud::Config cfg,
   for (const auto& [why, n] : rejected) std::printf(" (%s %zu)", why.c_str(), n);
   std::printf("\npoints %zu\ntime %.0f ns per contact\n", cloud.size(),
               contacts.empty() ? 0.0 : 1e9 * s / static_cast<double>(contacts.size()));
+  if (fused == 0 && added >= 100) {
+    std::fprintf(stderr,
+                 "taxel-fuse: warning: no contact fused with another: the association radius "
+                 "(%g m) is below the contacts' spacing; are they in millimetres (--scale "
+                 "0.001)?\n",
+                 o.radius);
+  }
   const auto kept = cloud.to_point_cloud({o.min_observations, o.max_sigma});
   std::printf("written %zu\n", kept.size());
   try {
@@ -243,6 +253,8 @@ int main(int argc, char** argv) {
       o.max_sigma = args.number<double>(0.0, kInf);
     } else if (a == "--ascii") {
       o.ascii = true;
+    } else if (a == "--scale") {
+      o.scale = args.number<double>(1e-300, 1e300);
     } else if (a == "--readings") {
       o.readings = std::string(args.value());
     } else if (a == "--poses") {
@@ -276,6 +288,11 @@ int main(int argc, char** argv) {
   const bool from_readings = !o.readings.empty(), from_session = !o.session.empty();
   if (from_readings && from_session) args.fail("--readings and --session exclude each other");
   if (from_readings && o.poses.empty()) args.fail("--readings needs --poses POSES.csv");
+  if ((from_readings || from_session) && o.scale != 1.0) {
+    args.fail(
+        "--scale applies to CONTACTS.csv; the readings' geometry is set in metres by "
+        "--pitch and --full-scale-depth");
+  }
   if (!from_readings && !from_session && !o.poses.empty()) {
     args.fail("--poses goes with --readings or --session");
   }
@@ -309,6 +326,16 @@ int main(int argc, char** argv) {
       }
     } else {
       contacts = taxel::io::read_contacts_csv(o.files[0]);
+      if (o.scale != 1.0) {
+        for (auto& c : contacts) {
+          c.position *= o.scale;
+          c.covariance *= o.scale * o.scale;
+        }
+      }
+      std::vector<Eigen::Vector3d> at;
+      at.reserve(contacts.size());
+      for (const auto& c : contacts) at.push_back(c.position);
+      taxel_cli::warn_if_millimetres("taxel-fuse", o.files[0], taxel_cli::largest_extent(at));
     }
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);

@@ -36,6 +36,8 @@ options:
                         radians (default 1e-6)
   --init "16 numbers"   initial T_target_source, row-major (default identity)
   --normal-neighbors K  neighbours of the PCA normals (default 12)
+  --scale F             multiply both clouds' coordinates by F first (--scale 0.001 for files
+                        in millimetres); the transform, distances and -o are then in metres
   -o FILE               also write the aligned source as PLY
   -h, --help            show this help
   --version             show taxel's version
@@ -60,6 +62,7 @@ struct Options {
   tr::IcpConfig icp;
   taxel::Isometry3d init = taxel::Isometry3d::Identity();
   int normal_neighbors = 12;
+  double scale = 1.0;
   std::string output;
   std::vector<std::string> inputs;
 };
@@ -111,6 +114,8 @@ Options parse(taxel_cli::Args& args) {
       o.init.matrix() = t;
     } else if (a == "--normal-neighbors") {
       o.normal_neighbors = args.number<int>(3, 1000);
+    } else if (a == "--scale") {
+      o.scale = args.number<double>(1e-300, 1e300);
     } else if (a == "-o") {
       o.output = std::string(args.value());
     } else if (a.size() > 1 && a[0] == '-') {
@@ -155,6 +160,15 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }
+  for (auto* cloud : {&source.cloud, &target.cloud}) {
+    if (opt.scale != 1.0) {
+      for (auto& p : cloud->points) p *= opt.scale;
+    }
+  }
+  taxel_cli::warn_if_millimetres("taxel-icp", opt.inputs[0],
+                                 taxel_cli::largest_extent(source.cloud.points));
+  taxel_cli::warn_if_millimetres("taxel-icp", opt.inputs[1],
+                                 taxel_cli::largest_extent(target.cloud.points));
   tr::IcpResult r;
   std::optional<tr::Target<double>> tg_storage;
   try {  // a model Target refuses (points too far apart to grid, bad normals) is bad data

@@ -34,6 +34,8 @@ options:
   --gate D           points farther than D count as D in the score (default 0.01)
   --starts N         cube-rotation starts, 0..24 (default 24)
   --format text|json (default text)
+  --scale F          multiply the cloud's and the models' coordinates by F first
+                     (--scale 0.001 for files in millimetres)
   -h, --help         show this help
   --version          show taxel's version
 
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   tr::LibraryConfig cfg;
   bool json = false;
+  double scale = 1.0;
   std::vector<std::string> inputs;
   std::string_view a;
   while (args.next(a)) {
@@ -62,6 +65,8 @@ int main(int argc, char** argv) {
       cfg.score_gate = args.number<double>(-kInf, kInf);
     } else if (a == "--starts") {
       cfg.rotation_starts = args.number<int>(-1000, 1000);
+    } else if (a == "--scale") {
+      scale = args.number<double>(1e-300, 1e300);
     } else if (a == "--format") {
       const auto v = args.value();
       if (v != "text" && v != "json") die("--format must be text or json");
@@ -99,14 +104,23 @@ int main(int argc, char** argv) {
     die(e.what(), 2);
   }
   try {
+    // Scaled, and checked for millimetres (a tactile object spans centimetres).
+    const auto load = [&](const std::string& path) {
+      taxel::PointCloud<double> c = taxel::io::read_ply(path).cloud;
+      if (scale != 1.0) {
+        for (auto& p : c.points) p *= scale;
+      }
+      taxel_cli::warn_if_millimetres("taxel-recognize", path, taxel_cli::largest_extent(c.points));
+      return c;
+    };
     for (const auto& m : models) {
       try {
-        lib->add(m.stem().string(), taxel::io::read_ply(m.string()).cloud);
+        lib->add(m.stem().string(), load(m.string()));
       } catch (const std::invalid_argument& e) {  // a model the library refuses: bad data
         die(m.string() + ": " + e.what(), 1);
       }
     }
-    r = lib->recognize(taxel::io::read_ply(inputs[0]).cloud);
+    r = lib->recognize(load(inputs[0]));
   } catch (const taxel::IoError& e) {
     die(e.what(), 1);
   }
