@@ -246,6 +246,16 @@ TEST_CASE("UniformGrid refuses clouds too wide to grid and survives huge coordin
     REQUIRE(a.has_value() == b.has_value());
     if (a) CHECK(a->id == b->id);
   }
+  // A squared distance that overflows is no distance: neither the grid nor brute force return
+  // such a point, even for r = infinity (found by fuzz_geometry: they used to disagree).
+  const std::vector<taxel::Vec3<double>> far{{3e-4, -9.6e303, 1e-284}};
+  const G far_grid(far);
+  ti::BruteForce<double> far_brute;
+  far_brute.insert(0, far[0]);
+  const double inf = std::numeric_limits<double>::infinity();
+  CHECK_FALSE(far_grid.nearest_within({0, 0, 0}, inf).has_value());
+  CHECK_FALSE(far_brute.nearest_within({0, 0, 0}, inf).has_value());
+  CHECK(far_grid.nearest_within({0, -9.6e303, 0}, inf).has_value());
   // All points equal: a valid grid of one occupied cell.
   const G same(std::vector<taxel::Vec3<double>>(5, taxel::Vec3<double>(1, 2, 3)));
   CHECK(same.nearest_within({1, 2, 3}, 0.0).has_value());

@@ -73,13 +73,17 @@ class BruteForce {
            slot_of_.capacity() * sizeof(PointId);
   }
 
-  /// The closest point within distance r of q (ties by id), if any. O(n).
+  /// The closest point within distance r of q (ties by id), if any. O(n). A point whose
+  /// squared distance overflows (farther than about 1e154 in double) is never returned.
   [[nodiscard]] std::optional<Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
     std::optional<Neighbor<S>> best;
     const S r2 = r * r;
     for (std::size_t i = 0; i < points_.size(); ++i) {
       const Neighbor<S> n{ids_[i], squared_distance(points_[i], q)};
-      if (n.squared_distance <= r2 && (!best || closer(n, *best))) best = n;
+      if (n.squared_distance <= r2 && n.squared_distance < std::numeric_limits<S>::infinity() &&
+          (!best || closer(n, *best))) {
+        best = n;
+      }
     }
     return best;
   }

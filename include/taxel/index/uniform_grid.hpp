@@ -136,12 +136,14 @@ class UniformGrid {
            order_.capacity() * sizeof(PointId);
   }
 
-  /// The closest point within distance r of q (ties by id), if any.
+  /// The closest point within distance r of q (ties by id), if any. A point whose squared
+  /// distance overflows (farther than about 1e154 in double) is never returned.
   [[nodiscard]] std::optional<Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
     if (points_.empty() || !q.allFinite() || !(r >= S(0))) return std::nullopt;
     Neighbor<S> best{0, r * r};
     bool found = false;
     const auto keep = [&](PointId id, S d2) {
+      if (!(d2 < std::numeric_limits<S>::infinity())) return;  // an overflowing distance
       if (d2 < best.squared_distance || (d2 == best.squared_distance && (!found || id < best.id))) {
         best = {id, d2};
         found = true;
