@@ -151,9 +151,9 @@ tl::Dataset hybrid_features(const std::vector<ts::PalmGraspSample>& data, const 
 }
 
 // Accuracy at each SNR of white noise on the test features; each fold's model is trained once
-// on clean features and tested at every SNR (noise on test data only; the paper does not say which side gets it).
-// The noise goes on the raw feature vector (`raw`) or on the vector after the training folds'
-// z-scoring (`standardised`, every feature at unit scale).
+// on clean features and tested at every SNR (noise on test data only; the paper does not say which
+// side gets it). The noise goes on the raw feature vector (`raw`) or on the vector after the
+// training folds' z-scoring (`standardised`, every feature at unit scale).
 struct SnrCurves {
   std::vector<double> raw;
   std::vector<double> standardised;

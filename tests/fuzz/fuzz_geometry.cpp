@@ -86,8 +86,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
     start.translation() = Vec3d(1e-3, 0, -1e-3);
     const std::span<const Vec3d> source(pts);
-    const tr::IcpResult a = tr::Icp<tr::PointToPlane>({.max_iterations = 10}).align(target, source, start);
-    const tr::IcpResult b = tr::Icp<tr::PointToPoint>({.max_iterations = 10}).align(target, source, start);
+    const tr::IcpResult a =
+        tr::Icp<tr::PointToPlane>({.max_iterations = 10}).align(target, source, start);
+    const tr::IcpResult b =
+        tr::Icp<tr::PointToPoint>({.max_iterations = 10}).align(target, source, start);
     for (const auto* r : {&a, &b}) {
       if (!r->transform.matrix().allFinite() || !std::isfinite(r->rmse)) std::abort();
     }

@@ -29,14 +29,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (back.cloud.points != d.cloud.points || back.triangles != d.triangles) std::abort();
     // Normals and every named field come back in place too (a property named twice once
     // swapped values on this round trip). NaN fields compare unequal, so compare bits.
-    if (back.cloud.normals != d.cloud.normals || back.cloud.fields.size() != d.cloud.fields.size()) {
+    if (back.cloud.normals != d.cloud.normals ||
+        back.cloud.fields.size() != d.cloud.fields.size()) {
       std::abort();
     }
     for (std::size_t f = 0; f < d.cloud.fields.size(); ++f) {
       const auto& x = d.cloud.fields[f];
       const auto& y = back.cloud.fields[f];
       if (x.name != y.name || x.values.size() != y.values.size() ||
-          std::memcmp(x.values.data(), y.values.data(), x.values.size() * sizeof(x.values[0])) != 0) {
+          std::memcmp(x.values.data(), y.values.data(), x.values.size() * sizeof(x.values[0])) !=
+              0) {
         std::abort();
       }
     }

@@ -22,7 +22,8 @@
 namespace taxel::drivers {
 
 /// The matrices of a SCHUNK SDH-2 hand: three fingers, each with a proximal 6x14 and a distal
-/// 6x13 matrix at 3.4 mm, 486 tactels (SCHUNK's SDH-2 documentation). Centres and angles are nominal.
+/// 6x13 matrix at 3.4 mm, 486 tactels (SCHUNK's SDH-2 documentation). Centres and angles are
+/// nominal.
 inline std::vector<dsa::MatrixInfo> sdh2_matrices() {
   std::vector<dsa::MatrixInfo> m;
   for (int finger = 0; finger < 3; ++finger) {
