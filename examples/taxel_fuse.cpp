@@ -127,7 +127,7 @@ int fuse(const Options& o, typename Cloud::Config cfg,
   for (const auto& [why, n] : rejected) std::printf(" (%s %zu)", why.c_str(), n);
   std::printf("\npoints %zu\ntime %.0f ns per contact\n", cloud.size(),
               contacts.empty() ? 0.0 : 1e9 * s / static_cast<double>(contacts.size()));
-  if (fused == 0 && added >= 100) {
+  if (o.policy != "raw" && fused == 0 && added >= 100) {  // raw never fuses
     std::fprintf(stderr,
                  "taxel-fuse: warning: no contact fused with another: the association radius "
                  "(%g m) is below the contacts' spacing; are they in millimetres (--scale "

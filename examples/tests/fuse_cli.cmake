@@ -247,3 +247,8 @@ if(err MATCHES "warning")
 endif()
 run_tool("${TOOL}" 2 --scale 0.001 --readings grasp.npy --poses grasp_poses.csv x.ply)
 expect("${err}" "--scale applies to CONTACTS.csv")
+# Raw keeps every contact by design: no "nothing fused" warning.
+run_tool("${TOOL}" 0 --policy raw --scale 0.001 mm.csv mm_raw.ply)
+if(err MATCHES "warning")
+  message(FATAL_ERROR "taxel-fuse --policy raw warned:\n${err}")
+endif()
