@@ -5,6 +5,7 @@
 #include "taxel/core/assert.hpp"
 #include "taxel/core/concepts.hpp"
 #include "taxel/core/contact.hpp"
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/error.hpp"
 #include "taxel/core/point_cloud.hpp"
 #include "taxel/core/status.hpp"

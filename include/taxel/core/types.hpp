@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "taxel/core/concepts.hpp"
+#include "taxel/core/deferred.hpp"
 
 namespace taxel {
 

@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/image/types.hpp"
 
 namespace taxel::image {
@@ -24,6 +25,7 @@ class Components {
   Components(Eigen::Index rows, Eigen::Index cols) { reserve(rows, cols); }
 
   /// Preallocates for `rows x cols` images.
+  template <class = void>
   void reserve(Eigen::Index rows, Eigen::Index cols) {
     detail::checked_pixels("Components", rows, cols);
     labels_.resize(rows, cols);
@@ -39,7 +41,8 @@ class Components {
   /// the fewest neighbours possible (a set pixel above is adjacent to every other scanned
   /// neighbour under 8-connectivity); every set's root is its smallest provisional label,
   /// which is the label of the component's first pixel in raster order.
-  int compute(const MaskView& mask, Connectivity connectivity = Connectivity::eight) {
+  template <class D = void>
+  int compute(const Deferred<MaskView, D>& mask, Connectivity connectivity = Connectivity::eight) {
     const Eigen::Index rows = mask.rows();
     const Eigen::Index cols = mask.cols();
     runs_.clear();
@@ -129,6 +132,7 @@ class Components {
 
   /// Clears from `mask`, which must be the mask of the last `compute`, every component with
   /// fewer than `min_area` pixels. Returns the number of components kept.
+  template <class = void>
   int clear_small(Mask& mask, int min_area) const {
     int kept = 0;
     for (int id = 1; id <= count_; ++id) kept += area_[static_cast<std::size_t>(id)] >= min_area;
@@ -178,7 +182,8 @@ class Components {
   // Masks up to 64 columns: rows as bit words, labels per run. A run joins the runs of the row
   // above that overlap it (widened by one column each side under 8-connectivity); labels are
   // written once, run by run, and areas are run lengths.
-  int compute_runs(const MaskView& mask, Connectivity connectivity) {
+  template <class D = void>
+  int compute_runs(const Deferred<MaskView, D>& mask, Connectivity connectivity) {
     const Eigen::Index rows = mask.rows();
     const Eigen::Index cols = mask.cols();
     const int widen = connectivity == Connectivity::eight ? 1 : 0;
@@ -271,6 +276,7 @@ class Components {
 
 /// Clears, in place, every component of `mask` with fewer than `min_area` pixels (MATLAB's
 /// `bwareaopen(BW, P)`, 8-connected by default). Returns the number of components kept.
+template <class = void>
 inline int remove_small_regions(Mask& mask, int min_area, Components& workspace,
                                 Connectivity connectivity = Connectivity::eight) {
   workspace.compute(mask, connectivity);
@@ -278,6 +284,7 @@ inline int remove_small_regions(Mask& mask, int min_area, Components& workspace,
 }
 
 /// Allocating convenience for `remove_small_regions`.
+template <class = void>
 inline int remove_small_regions(Mask& mask, int min_area,
                                 Connectivity connectivity = Connectivity::eight) {
   Components ws(mask.rows(), mask.cols());

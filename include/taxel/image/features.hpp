@@ -32,6 +32,7 @@ inline constexpr std::array<std::string_view, kEdgeFeatures> kEdgeFeatureNames =
 /// area, centroid x and y, bounding-box upper-left x and y, bounding-box length (width, along
 /// x) and width (height, along y), convex area (pixel count), eccentricity, Euler number
 /// (8-connected), orientation (degrees). An empty region gives zeros.
+template <class = void>
 inline void regional_features(const RegionProps& p, Eigen::Ref<Eigen::VectorXd> out) {
   out(0) = p.area;
   out(1) = p.centroid.x();

@@ -59,6 +59,7 @@ inline double fast_atan2(double y, double x) noexcept {
 
 /// Sobel derivatives of `img` into `gx` and `gy` (resized to the image's size).
 /// `gx = I (x) [-1 0 1; -2 0 2; -1 0 1]`, `gy = I (x) [-1 -2 -1; 0 0 0; 1 2 1]`.
+template <class = void>
 inline void sobel(const ImageView& img, ImageD& gx, ImageD& gy) {
   const Eigen::Index rows = img.rows();
   const Eigen::Index cols = img.cols();
@@ -85,6 +86,7 @@ inline void sobel(const ImageView& img, ImageD& gx, ImageD& gy) {
 
 /// Gradient magnitude and direction (degrees in (-180, 180], counter-clockwise from +x with y
 /// up) of `img`, as MATLAB's `[Gmag, Gdir] = imgradient(I)`. `gx`, `gy` are scratch.
+template <class = void>
 inline void gradient(const ImageView& img, ImageD& magnitude, ImageD& direction, ImageD& gx,
                      ImageD& gy) {
   sobel(img, gx, gy);
@@ -101,6 +103,7 @@ inline void gradient(const ImageView& img, ImageD& magnitude, ImageD& direction,
 }
 
 /// Sobel derivatives (gx, gy) at one pixel, replicate border; as `sobel` computes them.
+template <class = void>
 inline std::pair<double, double> sobel_at(const ImageView& img, Eigen::Index r,
                                           Eigen::Index c) noexcept {
   const Eigen::Index rows = img.rows();
@@ -119,6 +122,7 @@ namespace detail {
 
 // Sobel magnitude of `img` into `out` (rows * cols values, row-major). The border pixels take
 // the replicate rule; the interior loop has no tests, so that it vectorises.
+template <class = void>
 inline void gradient_magnitude_into(const ImageView& img, double* out) noexcept {
   const Eigen::Index rows = img.rows();
   const Eigen::Index cols = img.cols();
@@ -155,12 +159,14 @@ inline void gradient_magnitude_into(const ImageView& img, double* out) noexcept 
 
 /// Sobel gradient magnitude only, `sqrt(gx^2 + gy^2)` (no direction), into `magnitude`.
 /// The fast path of the hybrid features: interior pixels without border tests.
+template <class = void>
 inline void gradient_magnitude(const ImageView& img, ImageD& magnitude) {
   magnitude.resize(img.rows(), img.cols());
   detail::gradient_magnitude_into(img, magnitude.data());
 }
 
 /// Allocating convenience: gradient magnitude and direction of `img`.
+template <class = void>
 inline void gradient(const ImageView& img, ImageD& magnitude, ImageD& direction) {
   ImageD gx, gy;
   gradient(img, magnitude, direction, gx, gy);
@@ -168,6 +174,7 @@ inline void gradient(const ImageView& img, ImageD& magnitude, ImageD& direction)
 
 /// True when pixel (r, c) of `region` is a contour pixel: inside the region with at least one
 /// 4-neighbour outside it or outside the image (MATLAB's `bwperim(BW, 4)`).
+template <class = void>
 inline bool is_contour_pixel(const MaskView& region, Eigen::Index r, Eigen::Index c) noexcept {
   if (region(r, c) == 0) return false;
   if (r == 0 || c == 0 || r + 1 == region.rows() || c + 1 == region.cols()) return true;
@@ -176,6 +183,7 @@ inline bool is_contour_pixel(const MaskView& region, Eigen::Index r, Eigen::Inde
 }
 
 /// The contour pixels of `region` into `out` (resized).
+template <class = void>
 inline void contour(const MaskView& region, Mask& out) {
   out.resize(region.rows(), region.cols());
   for (Eigen::Index r = 0; r < region.rows(); ++r) {

@@ -88,6 +88,7 @@ class KMeans1d {
 
   /// The exact clustering of `values`. Empty input or a non-finite value gives
   /// `invalid_input` (k = 0).
+  template <class = void>
   const KMeans1dResult& fit(std::span<const double> values) {
     for (double v : values) {
       if (!std::isfinite(v)) return fail("a value is not finite");
@@ -109,6 +110,7 @@ class KMeans1d {
 
   /// The exact clustering of integer levels given as a histogram: `counts[i]` values equal to
   /// `first_level + i`. Faster than `fit` for quantised images (no sort).
+  template <class = void>
   const KMeans1dResult& fit_histogram(std::span<const std::uint32_t> counts,
                                       double first_level = 0.0) {
     value_.clear();
@@ -143,6 +145,7 @@ class KMeans1d {
   // merged in a small open-addressing table and only the distinct ones are sorted, instead of
   // sorting every value. Gives up (false) once more than n / 4 + 16 distinct values appear,
   // leaving the sort to `fit`. Fills value_ and weight_ as the sort would.
+  template <class = void>
   bool merge_few(std::span<const double> values) {
     const std::size_t cap = few_cap(values.size());
     const std::size_t size = std::bit_ceil(2 * cap);
@@ -303,6 +306,7 @@ class KMeans1d {
 };
 
 /// The exact k-means clustering of `values` (allocating convenience around `KMeans1d`).
+template <class = void>
 inline KMeans1dResult kmeans1d(std::span<const double> values, int k = 3) {
   KMeans1d solver(k, values.size());
   return solver.fit(values);
@@ -318,6 +322,7 @@ struct LloydConfig {
 /// Lloyd's algorithm from a seeded k-means++ start: a local optimum, deterministic for a given
 /// seed. Provided to compare against the exact solver; centroids are returned ascending. An
 /// emptied cluster is re-seeded at the value farthest from its centroid.
+template <class = void>
 inline KMeans1dResult kmeans1d_lloyd(std::span<const double> values, const LloydConfig& cfg = {}) {
   if (cfg.k < 1 || cfg.k > 255) {
     throw std::invalid_argument("kmeans1d_lloyd: k = " + std::to_string(cfg.k) +

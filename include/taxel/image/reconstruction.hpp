@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/image/segmentation.hpp"
 #include "taxel/image/types.hpp"
 
@@ -100,7 +101,8 @@ class Reconstructor {
   /// background than `background_fraction` of its length is skipped. Otherwise, when not raised
   /// and the edge condition holds, the level rises by T1 = k * I2; when raised and the opposite
   /// condition holds, it falls by T2 = k * I2. Contact pixels (or whole rows) take the level.
-  const ImageD& rec_edged(const Segmentation& seg) {
+  template <class D = void>
+  const Deferred<ImageD, D>& rec_edged(const Deferred<Segmentation, D>& seg) {
     const auto& cls = seg.classes;
     const Eigen::Index rows = cls.rows();
     const Eigen::Index cols = cls.cols();
@@ -149,7 +151,9 @@ class Reconstructor {
   /// least-squares polynomial of `degree` in the row coordinate normalised to [-1, 1] (the
   /// degree drops to rows - 1 when fewer rows remain); and pastes the block back into a zero
   /// M x N frame at its original rows and columns. All background gives an all-zero map.
-  const ImageD& rec_edgeless(const ImageView& img, const Segmentation& seg) {
+  template <class D = void>
+  const Deferred<ImageD, D>& rec_edgeless(const Deferred<ImageView, D>& img,
+                                          const Deferred<Segmentation, D>& seg) {
     const auto& cls = seg.classes;
     const Eigen::Index rows = cls.rows();
     const Eigen::Index cols = cls.cols();
@@ -206,6 +210,7 @@ class Reconstructor {
   [[nodiscard]] const ImageD& height() const noexcept { return height_; }
 
  private:
+  template <class = void>
   void heal(Eigen::Index m1, Eigen::Index n1) {
     if (edgeless_.healing == Healing::none) return;
     for (Eigen::Index i = 0; i < m1; ++i) {
@@ -239,6 +244,7 @@ class Reconstructor {
     }
   }
 
+  template <class = void>
   void fit_columns(Eigen::Index m1, Eigen::Index n1) {
     const int d = static_cast<int>(std::min<Eigen::Index>(edgeless_.degree, m1 - 1));
     // Vandermonde rows v_i = (1, x_i, ..., x_i^d) with x normalised to [-1, 1], kept in
@@ -281,6 +287,7 @@ class Reconstructor {
     for (int a = 1; a <= d; ++a) out[a] = out[a - 1] * x;
   }
 
+  template <class = void>
   void smooth3x3(PostProcess kind) {
     const Eigen::Index rows = height_.rows();
     const Eigen::Index cols = height_.cols();

@@ -13,6 +13,7 @@
 #include <numbers>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/image/components.hpp"
 #include "taxel/image/types.hpp"
 
@@ -78,7 +79,8 @@ class RegionAnalyzer {
   [[nodiscard]] const RegionPropsOptions& options() const noexcept { return opt_; }
 
   /// Descriptors of the non-zero pixels of `mask`, taken as one region.
-  const RegionProps& compute(const MaskView& mask) {
+  template <class D = void>
+  const Deferred<RegionProps, D>& compute(const Deferred<MaskView, D>& mask) {
     RegionProps& p = props_;
     p.convex_hull.clear();
     p.area = 0;
@@ -228,8 +230,9 @@ class RegionAnalyzer {
   // Euler numbers from Gray's bit-quad counts over the zero-padded bounding box: each row pair
   // is packed into one 0/1 byte row with a zero border, and the 2x2 windows are tallied
   // without branches.
-  void euler(const MaskView& mask, Eigen::Index rmin, Eigen::Index rmax, Eigen::Index cmin,
-             Eigen::Index cmax) {
+  template <class D = void>
+  void euler(const Deferred<MaskView, D>& mask, Eigen::Index rmin, Eigen::Index rmax,
+             Eigen::Index cmin, Eigen::Index cmax) {
     if (mask.cols() <= kPackedCols) {
       // Bit j of a row word shifted left by one is the pixel of window column j - 1, so bit 0
       // and bit cols + 1 are the zero border; window j spans bits j and j + 1.
@@ -269,7 +272,7 @@ class RegionAnalyzer {
         const int sum = a + b + d + e;
         q1 += sum == 1 ? 1 : 0;
         q3 += sum == 3 ? 1 : 0;
-        qd += (sum == 2) & (a == e) ? 1 : 0;
+        qd += ((sum == 2) & (a == e)) ? 1 : 0;
       }
       std::swap(above, below);
     }
@@ -304,6 +307,7 @@ class RegionAnalyzer {
   // stepping gives (along the longer axis, the other coordinate rounded half away from zero);
   // each pair of consecutive points that differ in x is a horizontal edge at (min x, min y).
   // Only edges on pixel-centre columns (x = 5 col - 2) toggle the pixel below them.
+  template <class = void>
   void toggle_edges(std::int64_t x1, std::int64_t y1, std::int64_t x2, std::int64_t y2,
                     Eigen::Index rows, Eigen::Index cols) {
     const std::int64_t dx = std::abs(x2 - x1);
@@ -345,6 +349,7 @@ class RegionAnalyzer {
     }
   }
 
+  template <class = void>
   void convex(Eigen::Index rmin, Eigen::Index rmax, Eigen::Index cmin, Eigen::Index cmax,
               double base) {
     // Candidate points: edge midpoints of the first and last pixel of every row, in doubled
@@ -445,7 +450,8 @@ class RegionAnalyzer {
     props_.solidity = count > 0 ? props_.area / props_.convex_area : 0.0;
   }
 
-  void perimeter(const MaskView& mask) {
+  template <class D = void>
+  void perimeter(const Deferred<MaskView, D>& mask) {
     static constexpr int kDr[8] = {0, -1, -1, -1, 0, 1, 1, 1};  // W NW N NE E SE S SW
     static constexpr int kDc[8] = {-1, -1, 0, 1, 1, 1, 0, -1};
     const Eigen::Index rows = mask.rows();
@@ -542,7 +548,9 @@ class RegionAnalyzer {
 };
 
 /// Allocating convenience: the descriptors of the non-zero pixels of `mask` as one region.
-inline RegionProps region_props(const MaskView& mask, const RegionPropsOptions& opt = {}) {
+template <class D = void>
+inline RegionProps region_props(const Deferred<MaskView, D>& mask,
+                                const Deferred<RegionPropsOptions, D>& opt = {}) {
   RegionAnalyzer a(opt, mask.rows(), mask.cols());
   return a.compute(mask);
 }

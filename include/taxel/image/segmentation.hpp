@@ -95,6 +95,7 @@ class Segmenter {
   /// gives `invalid_input` with every
   /// output cleared to background. An image with one distinct value is all background (no
   /// HPR); with two, the upper value is high pressure and there is no low-pressure class.
+  template <class = void>
   const Segmentation& run(const ImageView& img) {
     const Eigen::Index rows = img.rows();
     const Eigen::Index cols = img.cols();
@@ -305,6 +306,7 @@ class Segmenter {
 };
 
 /// Allocating convenience: segments one image.
+template <class = void>
 inline Segmentation segment(const ImageView& img, const SegmentationConfig& cfg = {}) {
   Segmenter s(cfg, img.rows(), img.cols());
   return s.run(img);

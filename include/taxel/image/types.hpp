@@ -55,6 +55,7 @@ namespace detail {
 
 /// `rows * cols` when both are >= 0 and the product is at most kMaxImagePixels; otherwise
 /// throws std::invalid_argument naming `who` (a negative size never reaches an allocation).
+template <class = void>
 inline Eigen::Index checked_pixels(const char* who, Eigen::Index rows, Eigen::Index cols) {
   if (rows < 0 || cols < 0 || (cols > 0 && rows > kMaxImagePixels / cols)) {
     throw std::invalid_argument(std::string(who) + ": an image of " + std::to_string(rows) + " x " +
@@ -66,6 +67,7 @@ inline Eigen::Index checked_pixels(const char* who, Eigen::Index rows, Eigen::In
 }
 
 /// The non-zero pixels of a mask row of at most 64 pixels as bits (bit c = pixel c).
+template <class = void>
 inline std::uint64_t pack_row(const std::uint8_t* m, Eigen::Index cols) noexcept {
   std::uint64_t bits = 0;
   Eigen::Index c = 0;

@@ -38,6 +38,7 @@ inline constexpr std::array<std::string_view, 14> kContactColumns{
 inline constexpr std::size_t kMaxContacts = std::size_t{1} << 26;
 
 /// Parses a contacts CSV held in memory. Throws IoError with "<source>:<line>: column <c>: ...".
+template <class = void>
 inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
                                                        const std::string& source = "<csv>") {
   std::vector<Contact<double>> out;
@@ -140,12 +141,14 @@ inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
 }
 
 /// Reads a contacts CSV file. Throws IoError.
+template <class = void>
 inline std::vector<Contact<double>> read_contacts_csv(const std::string& path) {
   return parse_contacts_csv(read_file(path), path);
 }
 
 /// Encodes contacts with every column (kContactColumns); empty normal cells for contacts
 /// without one. Numbers in shortest round-trip form.
+template <class = void>
 inline std::string encode_contacts_csv(const std::vector<Contact<double>>& contacts) {
   std::string out;
   for (std::size_t k = 0; k < kContactColumns.size(); ++k) {
@@ -179,6 +182,7 @@ inline std::string encode_contacts_csv(const std::vector<Contact<double>>& conta
 }
 
 /// Writes a contacts CSV file. Throws IoError.
+template <class = void>
 inline void write_contacts_csv(const std::string& path,
                                const std::vector<Contact<double>>& contacts) {
   write_file(path, encode_contacts_csv(contacts));

@@ -65,6 +65,7 @@ inline void check_size(const std::string& source, std::uint64_t frames, std::uin
 }  // namespace detail
 
 /// Parses a CSV image. Throws IoError naming the line (and column) of the first error.
+template <class = void>
 inline ImageStack parse_image_csv(std::string_view text, const std::string& source = "<csv>") {
   ImageStack out;
   out.frames = 1;
@@ -122,6 +123,7 @@ inline ImageStack parse_image_csv(std::string_view text, const std::string& sour
 /// Parses a PGM image (P2 ASCII or P5 binary, maxval 1..65535, 16-bit samples big-endian as
 /// Netpbm specifies). Several images of the same size, one after another, make a stack.
 /// Throws IoError with the byte offset of the first error.
+template <class = void>
 inline ImageStack parse_pgm(std::string_view bytes, const std::string& source = "<pgm>") {
   ImageStack out;
   std::size_t pos = 0;
@@ -225,6 +227,7 @@ inline ImageStack parse_pgm(std::string_view bytes, const std::string& source = 
 /// 3-D stack (frames, rows, cols) of little-endian or byte-wide integers ('u1', 'i1', 'u2',
 /// 'i2', 'u4', 'i4', 'u8', 'i8') or floats ('f4', 'f8'), C or Fortran order. Non-finite floats
 /// are refused. Throws IoError with the byte offset of the first error.
+template <class = void>
 inline ImageStack parse_npy(std::string_view bytes, const std::string& source = "<npy>") {
   static constexpr char kMagic[] = "\x93NUMPY";
   if (bytes.size() < 10 || bytes.substr(0, 6) != std::string_view(kMagic, 6)) {
@@ -385,6 +388,7 @@ inline ImageStack parse_npy(std::string_view bytes, const std::string& source = 
 }
 
 /// Reads an image or a stack from a file, choosing the format by extension (.csv, .pgm, .npy).
+template <class = void>
 inline ImageStack read_image(const std::string& path) {
   const std::string ext = extension(path);
   if (ext == ".csv" || ext == ".txt") return parse_image_csv(read_file(path), path);
@@ -395,6 +399,7 @@ inline ImageStack read_image(const std::string& path) {
 
 /// Encodes an image as binary PGM (P5): values are mapped linearly from [lo, hi] to
 /// [0, maxval] (clamped, rounded); maxval 255 gives 8-bit, up to 65535 gives 16-bit samples.
+template <class = void>
 inline std::string encode_pgm(const image::ImageView& img, double lo = 0.0, double hi = 255.0,
                               int maxval = 255) {
   if (maxval < 1 || maxval > 65535) throw std::invalid_argument("encode_pgm: maxval in [1, 65535]");
@@ -461,6 +466,7 @@ inline std::string encode_npy(const ImageStack& stack, NpyDtype dtype = NpyDtype
 }
 
 /// Encodes one image as CSV (full precision, one row per line).
+template <class = void>
 inline std::string encode_image_csv(const image::ImageView& img) {
   std::string out;
   char buf[32];

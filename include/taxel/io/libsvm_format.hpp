@@ -53,6 +53,7 @@ inline std::string libsvm_quote(std::string_view t) {
 /// Parses libsvm text into a dense data set. Labels must be integers (`+1`, `-1`, `3`, `2.0`);
 /// `qid:<n>` after the label becomes the sample's group id (all lines or none). Blank lines are
 /// skipped. Throws taxel::IoError "<source>:<line>: column <c>: <what was expected>".
+template <class = void>
 inline learn::Dataset parse_libsvm(std::string_view text, const std::string& source = "<libsvm>",
                                    const LibsvmReadOptions& opt = {}) {
   struct Entry {
@@ -181,12 +182,14 @@ inline learn::Dataset parse_libsvm(std::string_view text, const std::string& sou
 }
 
 /// Reads a libsvm file (see parse_libsvm).
+template <class = void>
 inline learn::Dataset read_libsvm(const std::string& path, const LibsvmReadOptions& opt = {}) {
   return parse_libsvm(read_file(path), path, opt);
 }
 
 /// Writes a data set as libsvm text: non-zero features only, numbers that round-trip exactly,
 /// `qid:` when the set has group ids.
+template <class = void>
 inline std::string encode_libsvm(const learn::DatasetView& d) {
   std::string s;
   char buf[40];

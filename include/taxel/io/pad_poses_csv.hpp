@@ -42,6 +42,7 @@ struct PadPose {
 /// problem: a missing column, a cell that is not a finite number, a negative or fractional
 /// index, a quaternion whose norm differs from 1 by more than 1e-3 (it is normalised
 /// otherwise), or the same frame and pad twice.
+template <class = void>
 inline std::vector<PadPose> parse_pad_poses_csv(std::string_view text,
                                                 const std::string& source = "<poses>") {
   LineReader lines(text);
@@ -153,12 +154,14 @@ inline std::vector<PadPose> parse_pad_poses_csv(std::string_view text,
 }
 
 /// Reads a pad poses file (see parse_pad_poses_csv).
+template <class = void>
 inline std::vector<PadPose> read_pad_poses_csv(const std::string& path) {
   return parse_pad_poses_csv(read_file(path), path);
 }
 
 /// The CSV text of `poses` (header frame,pad,x,y,z,qw,qx,qy,qz and, when every pose has a
 /// finite time, time; shortest round-trip decimal form).
+template <class = void>
 inline std::string encode_pad_poses_csv(std::span<const PadPose> poses) {
   const bool timed = std::all_of(poses.begin(), poses.end(),
                                  [](const PadPose& p) { return std::isfinite(p.time); });

@@ -51,6 +51,7 @@ inline std::array<std::uint8_t, 3> ramp(double t) {
 
 /// Colours `img` with `ramp`, mapping [lo, hi] to [0, 1]; each pixel becomes `scale x scale`.
 /// lo == hi maps everything to the ramp's start.
+template <class = void>
 inline RgbImage colorize(const image::ImageView& img, double lo, double hi, int scale = 8) {
   if (scale < 1) throw std::invalid_argument("colorize: scale must be >= 1");
   RgbImage out(img.rows() * scale, img.cols() * scale);
@@ -65,6 +66,7 @@ inline RgbImage colorize(const image::ImageView& img, double lo, double hi, int 
 }
 
 /// Colours small integer classes (0 = black, then distinct colours), `scale x scale` each.
+template <class = void>
 inline RgbImage colorize_classes(const Eigen::Ref<const image::Image<std::uint8_t>>& classes,
                                  int scale = 8) {
   static constexpr std::uint8_t kPalette[8][3] = {{0, 0, 0},       {110, 110, 110}, {255, 255, 255},
@@ -82,6 +84,7 @@ inline RgbImage colorize_classes(const Eigen::Ref<const image::Image<std::uint8_
 }
 
 /// Places pictures side by side with `gap` white pixels between them (top-aligned).
+template <class = void>
 inline RgbImage side_by_side(const std::vector<RgbImage>& panels, Eigen::Index gap = 8) {
   Eigen::Index rows = 0, cols = 0;
   for (const auto& p : panels) {
@@ -101,6 +104,7 @@ inline RgbImage side_by_side(const std::vector<RgbImage>& panels, Eigen::Index g
 }
 
 /// Places pictures one above the other with `gap` white pixels between them (left-aligned).
+template <class = void>
 inline RgbImage stacked(const std::vector<RgbImage>& panels, Eigen::Index gap = 8) {
   Eigen::Index rows = 0, cols = 0;
   for (const auto& p : panels) {

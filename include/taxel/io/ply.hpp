@@ -196,6 +196,7 @@ class PlyBody {
 /// Parses a PLY file held in memory. Throws IoError with the line or byte of the first error:
 /// a bad magic or format, big-endian data, unknown types, missing x/y/z, counts the file cannot
 /// hold, truncation, malformed or non-finite numbers, face indices out of range, trailing data.
+template <class = void>
 inline PlyData parse_ply(std::string_view bytes, const std::string& source = "<ply>") {
   using namespace detail;
   LineReader header(bytes);
@@ -432,6 +433,7 @@ inline PlyData read_ply(const std::string& path) { return parse_ply(read_file(pa
 
 /// Encodes `cloud` (and optional triangles) as PLY: x, y, z as double, normals when present
 /// (nx, ny, nz), then every field as a double property, then faces (uchar count, int indices).
+template <class = void>
 inline std::string encode_ply(const PointCloud<double>& cloud,
                               PlyFormat format = PlyFormat::binary_little_endian,
                               const std::vector<std::array<std::uint32_t, 3>>& triangles = {}) {
@@ -498,6 +500,7 @@ inline std::string encode_ply(const PointCloud<double>& cloud,
 }
 
 /// Writes a PLY file. Throws IoError on failure, std::invalid_argument for an invalid cloud.
+template <class = void>
 inline void write_ply(const std::string& path, const PointCloud<double>& cloud,
                       PlyFormat format = PlyFormat::binary_little_endian,
                       const std::vector<std::array<std::uint32_t, 3>>& triangles = {}) {

@@ -33,6 +33,7 @@ inline void write_png(const std::string& path, const RgbImage& img) {
 }
 
 /// Reads a PNG file into an RGB picture (any PNG colour type is converted). Throws IoError.
+template <class = void>
 inline RgbImage read_png(const std::string& path) {
   png_image desc{};
   desc.version = PNG_IMAGE_VERSION;

@@ -232,6 +232,7 @@ struct CloudView {
 /// first, each coloured by `values[i]` (ramp of picture.hpp) with a colour bar; `values` may be
 /// empty (one colour). Non-finite points are left out. Throws std::invalid_argument when the
 /// sizes differ or the picture is smaller than 160 x 120.
+template <class = void>
 inline std::string render_cloud_svg(const std::vector<Vec3d>& points,
                                     const std::vector<double>& values, const CloudView& view) {
   using detail::svg_escape;

@@ -52,6 +52,7 @@ struct Dataset {
 };
 
 /// The rows `index` of `d`, in that order (groups too when present).
+template <class = void>
 inline Dataset subset(const DatasetView& d, std::span<const std::size_t> index) {
   Dataset out;
   out.x.resize(static_cast<Eigen::Index>(index.size()), d.dims());
@@ -89,6 +90,7 @@ inline int class_index(std::span<const int> classes, int label) noexcept {
 /// Checks a training set: at least one sample and one feature, one label (and group, when
 /// given) per row, finite features, and at least `min_classes` distinct labels.
 /// `who` prefixes the message (the classifier's name).
+template <class = void>
 inline Outcome validate_training_set(const DatasetView& d, const std::string& who,
                                      std::size_t min_classes = 2) {
   const auto fail = [&](std::string why) {
@@ -123,6 +125,7 @@ inline Outcome validate_training_set(const DatasetView& d, const std::string& wh
 namespace detail {
 /// Throws std::logic_error before training, std::invalid_argument unless `x` has `dims`
 /// features.
+template <class = void>
 inline void check_sample_size(const SampleRef& x, Eigen::Index dims, const char* who) {
   if (dims == 0) throw std::logic_error(std::string(who) + ": the model is not trained");
   if (x.size() != dims) {
@@ -131,6 +134,7 @@ inline void check_sample_size(const SampleRef& x, Eigen::Index dims, const char*
   }
 }
 /// Throws like check_sample_size, and std::invalid_argument for a non-finite feature.
+template <class = void>
 inline void check_sample(const SampleRef& x, Eigen::Index dims, const char* who) {
   check_sample_size(x, dims, who);
   if (!x.allFinite()) {

@@ -33,6 +33,7 @@ using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
 /// one fold: groups are shuffled, then placed largest first into the fold with the fewest
 /// samples. Returns `invalid_input` for k < 2, k above the number of samples (or groups), or a
 /// group list of the wrong length.
+template <class = void>
 inline Result<std::vector<int>> kfold_assignment(std::span<const int> y, int k, std::uint64_t seed,
                                                  std::span<const int> groups = {}) {
   using R = Result<std::vector<int>>;

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/dataset.hpp"
 
@@ -46,7 +47,8 @@ class Knn {
   }
 
   /// Stores the training set. `invalid_input` when it has fewer than k samples.
-  Outcome fit(const DatasetView& d) {
+  template <class D = void>
+  Outcome fit(const Deferred<DatasetView, D>& d) {
     Outcome o = validate_training_set(d, "Knn", 1);
     if (!o) return o;
     if (d.rows() < cfg_.k) {
@@ -61,14 +63,17 @@ class Knn {
     return o;
   }
 
-  void decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
+  template <class D = void>
+  void decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     detail::check_sample(x, dims(), "Knn");
     vote(x, out);
     out /= out.sum();
   }
-  [[nodiscard]] int predict(const SampleRef& x) const {
+  template <class D = void>
+  [[nodiscard]] int predict(const Deferred<SampleRef, D>& x) const {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     detail::check_sample(x, dims(), "Knn");
-    Eigen::VectorXd votes(static_cast<Eigen::Index>(classes_.size()));
+    VectorXd votes(static_cast<Eigen::Index>(classes_.size()));
     const int nearest = vote(x, votes);
     const double top = votes.maxCoeff();
     if (votes(nearest) == top) return classes_[static_cast<std::size_t>(nearest)];
@@ -81,11 +86,13 @@ class Knn {
 
  private:
   // Fills votes per class; returns the class of the nearest neighbour.
-  int vote(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> votes) const {
+  template <class D = void>
+  int vote(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> votes) const {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     const Eigen::Index n = x_.rows();
     std::vector<std::pair<double, Eigen::Index>> dist(static_cast<std::size_t>(n));
     if (cfg_.metric == KnnMetric::euclidean) {
-      const Eigen::VectorXd dots = x_ * x;
+      const VectorXd dots = x_ * x;
       const double xx = x.squaredNorm();
       for (Eigen::Index i = 0; i < n; ++i) {
         dist[static_cast<std::size_t>(i)] = {std::max(0.0, sq_(i) + xx - 2.0 * dots(i)), i};

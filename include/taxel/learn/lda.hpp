@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/dataset.hpp"
 
@@ -39,15 +40,18 @@ class Lda {
     }
   }
 
-  Outcome fit(const DatasetView& d) {
+  template <class D = void>
+  Outcome fit(const Deferred<DatasetView, D>& d) {
+    using MatrixXd = Deferred<Eigen::MatrixXd, D>;
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     Outcome o = validate_training_set(d, "Lda");
     if (!o) return o;
     std::vector<int> classes = class_order(d.y);
     const auto k = static_cast<Eigen::Index>(classes.size());
     const Eigen::Index n = d.rows();
     const Eigen::Index dims = d.dims();
-    Eigen::MatrixXd means = Eigen::MatrixXd::Zero(k, dims);
-    Eigen::VectorXd count = Eigen::VectorXd::Zero(k);
+    MatrixXd means = MatrixXd::Zero(k, dims);
+    VectorXd count = VectorXd::Zero(k);
     std::vector<int> cls(static_cast<std::size_t>(n));
     for (Eigen::Index i = 0; i < n; ++i) {
       const int c = class_index(classes, d.y[static_cast<std::size_t>(i)]);
@@ -56,16 +60,17 @@ class Lda {
       count(c) += 1.0;
     }
     for (Eigen::Index c = 0; c < k; ++c) means.row(c) /= count(c);
-    Eigen::MatrixXd centred(n, dims);
+    MatrixXd centred(n, dims);
     for (Eigen::Index i = 0; i < n; ++i)
       centred.row(i) = d.x.row(i) - means.row(cls[static_cast<std::size_t>(i)]);
-    Eigen::MatrixXd s = Eigen::MatrixXd::Zero(dims, dims);
-    s.selfadjointView<Eigen::Lower>().rankUpdate(centred.transpose(), 1.0 / static_cast<double>(n));
-    s = s.selfadjointView<Eigen::Lower>();
+    MatrixXd s = MatrixXd::Zero(dims, dims);
+    s.template selfadjointView<Eigen::Lower>().rankUpdate(centred.transpose(),
+                                                          1.0 / static_cast<double>(n));
+    s = s.template selfadjointView<Eigen::Lower>();
     const double mu = s.trace() / static_cast<double>(dims);
     double shrink = cfg_.shrinkage;
     if (shrink < 0.0) {
-      const double d2 = (s - mu * Eigen::MatrixXd::Identity(dims, dims)).squaredNorm();
+      const double d2 = (s - mu * MatrixXd::Identity(dims, dims)).squaredNorm();
       double b2 = 0.0;
       for (Eigen::Index i = 0; i < n; ++i) b2 += std::pow(centred.row(i).squaredNorm(), 2);
       b2 = (b2 / static_cast<double>(n) - s.squaredNorm()) / static_cast<double>(n);
@@ -76,15 +81,15 @@ class Lda {
     const double mu_u = s.trace() / static_cast<double>(dims);
     s = (1.0 - shrink) * s;
     s.diagonal().array() += shrink * mu_u;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(s);
-    const Eigen::VectorXd& ev = eig.eigenvalues();
+    Eigen::SelfAdjointEigenSolver<MatrixXd> eig(s);
+    const VectorXd& ev = eig.eigenvalues();
     const double top = ev.maxCoeff();
     if (!(top > 0.0)) {
       return {Status::degenerate, "Lda: every feature is constant within the classes"};
     }
-    Eigen::VectorXd inv(ev.size());
+    VectorXd inv(ev.size());
     for (Eigen::Index j = 0; j < ev.size(); ++j) inv(j) = ev(j) > 1e-10 * top ? 1.0 / ev(j) : 0.0;
-    const Eigen::MatrixXd proj = means * eig.eigenvectors();  // k x dims
+    const MatrixXd proj = means * eig.eigenvectors();  // k x dims
     w_ = proj * inv.asDiagonal() * eig.eigenvectors().transpose();
     b_.resize(k);
     for (Eigen::Index c = 0; c < k; ++c) {
@@ -98,11 +103,13 @@ class Lda {
     return o;
   }
 
-  void decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
+  template <class D = void>
+  void decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     detail::check_sample(x, dims(), "Lda");
     out = w_ * x + b_;
   }
-  [[nodiscard]] int predict(const SampleRef& x) const {
+  template <class D = void>
+  [[nodiscard]] int predict(const Deferred<SampleRef, D>& x) const {
     detail::check_sample(x, dims(), "Lda");
     Eigen::Index best = 0;
     double best_v = -std::numeric_limits<double>::infinity();

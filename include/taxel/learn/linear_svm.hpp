@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/error.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/dataset.hpp"
@@ -71,7 +72,9 @@ class LinearSvm {
   /// Trains on `d`. Returns `invalid_input` (keeping the previous model) for an empty set,
   /// non-finite features, mismatched sizes or fewer than two classes; `not_converged` when a
   /// binary problem stopped at max_iterations (the model is the last iterate and usable).
-  Outcome fit(const DatasetView& d) {
+  template <class D = void>
+  Outcome fit(const Deferred<DatasetView, D>& d) {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     Outcome check = validate_training_set(d, "LinearSvm");
     if (!check) return check;
     std::vector<int> classes = class_order(d.y);
@@ -80,7 +83,7 @@ class LinearSvm {
     const int nr_class = static_cast<int>(classes.size());
     const int nr_w = nr_class == 2 ? 1 : nr_class;
 
-    Eigen::VectorXd qd_base(n);  // ||x_i||^2 + bias^2
+    VectorXd qd_base(n);  // ||x_i||^2 + bias^2
     const double b2 = cfg_.bias >= 0.0 ? cfg_.bias * cfg_.bias : 0.0;
     for (Eigen::Index i = 0; i < n; ++i) {
       qd_base(i) = d.x.row(i).squaredNorm() + b2;
@@ -93,7 +96,7 @@ class LinearSvm {
     }
 
     FeatureMatrix w(nr_w, dims);
-    Eigen::VectorXd wb(nr_w);
+    VectorXd wb(nr_w);
     LinearSvmTrainInfo info;
     std::mt19937_64 rng(cfg_.seed);
     std::vector<signed char> sign(static_cast<std::size_t>(n));
@@ -102,7 +105,7 @@ class LinearSvm {
       for (Eigen::Index i = 0; i < n; ++i) {
         sign[static_cast<std::size_t>(i)] = d.y[static_cast<std::size_t>(i)] == classes[k] ? 1 : -1;
       }
-      Eigen::VectorXd wk = Eigen::VectorXd::Zero(dims);
+      VectorXd wk = VectorXd::Zero(dims);
       double wbk = 0.0;
       std::vector<double> trace;
       const Solve s =
@@ -137,7 +140,8 @@ class LinearSvm {
 
   /// Decision values, one per class in `classes()` order (for two classes: `f` and `-f`).
   /// Throws std::invalid_argument for a sample of the wrong length or non-finite features.
-  void decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
+  template <class D = void>
+  void decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     detail::check_sample_size(x, dims(), "LinearSvm");
     if (out.size() != static_cast<Eigen::Index>(classes_.size())) {
       throw std::invalid_argument("LinearSvm::decision: the output has " +
@@ -156,7 +160,8 @@ class LinearSvm {
   }
 
   /// The predicted label. Throws like decision(). Allocates nothing.
-  [[nodiscard]] int predict(const SampleRef& x) const {
+  template <class D = void>
+  [[nodiscard]] int predict(const Deferred<SampleRef, D>& x) const {
     detail::check_sample_size(x, dims(), "LinearSvm");
     // A non-finite feature makes some decision value non-finite (0 * inf is NaN too), so the
     // scores are checked instead of the sample.
@@ -207,6 +212,7 @@ class LinearSvm {
   /// `load_model`): header lines `solver_type`, `nr_class`, `label`, `nr_feature`, `bias`, then
   /// `w` and one line per feature (plus one for the bias feature) holding one weight per binary
   /// problem. Numbers are written to round-trip exactly.
+  template <class = void>
   [[nodiscard]] std::string save() const {
     if (dims() == 0) throw std::logic_error("LinearSvm::save: the model is not trained");
     std::string s;
@@ -229,8 +235,10 @@ class LinearSvm {
 
   /// Reads a LIBLINEAR model file's text (any of LIBLINEAR's classification solvers; the model
   /// then predicts as LIBLINEAR does). Throws taxel::IoError naming `source` and the line.
+  template <class D = void>
   [[nodiscard]] static LinearSvm load(std::string_view text,
                                       const std::string& source = "<model>") {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     Tokens tok(text, source);
     LinearSvm m;
     int nr_class = -1;
@@ -295,7 +303,7 @@ class LinearSvm {
                " weights, found " + std::to_string(values.size()));
     }
     m.w_.resize(nr_w, dims);
-    m.wb_ = Eigen::VectorXd::Zero(nr_w);
+    m.wb_ = VectorXd::Zero(nr_w);
     for (Eigen::Index j = 0; j < rows; ++j) {
       for (Eigen::Index k = 0; k < nr_w; ++k) {
         const double v = values[static_cast<std::size_t>(j * nr_w + k)];
@@ -322,16 +330,20 @@ class LinearSvm {
     throw std::invalid_argument("LinearSvm: a decision value overflowed (features too large)");
   }
 
-  [[nodiscard]] double raw_value(const SampleRef& x, Eigen::Index k) const noexcept {
+  template <class D = void>
+  [[nodiscard]] double raw_value(const Deferred<SampleRef, D>& x, Eigen::Index k) const noexcept {
     double v = w_.row(k).dot(x.transpose());
     if (bias_ >= 0.0) v += bias_ * wb_(k);
     return v;
   }
 
   // Dual coordinate descent of LIBLINEAR's solve_l2r_l1l2_svc, on dense rows.
-  Solve solve(const Eigen::Ref<const FeatureMatrix>& x, const std::vector<signed char>& y,
-              const Eigen::VectorXd& qd_base, Eigen::VectorXd& w, double& wb, std::mt19937_64& rng,
-              std::vector<double>* trace) const {
+  template <class D = void>
+  Solve solve(const Deferred<Eigen::Ref<const FeatureMatrix>, D>& x,
+              const Deferred<std::vector<signed char>, D>& y,
+              const Deferred<Eigen::VectorXd, D>& qd_base, Eigen::VectorXd& w, double& wb,
+              std::mt19937_64& rng, std::vector<double>* trace) const {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     const auto n = static_cast<std::size_t>(x.rows());
     const Eigen::Index dims = x.cols();
     const double bias = cfg_.bias;
@@ -364,8 +376,7 @@ class LinearSvm {
       for (std::size_t s = 0; s < active; ++s) {
         const std::size_t i = index[s];
         const double yi = y[i];
-        const Eigen::Map<const Eigen::VectorXd> xi(base + static_cast<Eigen::Index>(i) * stride,
-                                                   dims);
+        const Eigen::Map<const VectorXd> xi(base + static_cast<Eigen::Index>(i) * stride, dims);
         double g = xi.dot(w);
         if (has_bias) g += bias * wb;
         g = yi * g - 1.0 + alpha[i] * diag;
@@ -421,8 +432,9 @@ class LinearSvm {
   }
 
   // 1/2 a'(Q + D)a - e'a = 1/2 (|w|^2 + sum a_i^2 D_ii) - sum a_i.
-  static double dual_objective(const Eigen::VectorXd& w, double wb,
-                               const std::vector<double>& alpha, double diag) {
+  template <class D = void>
+  static double dual_objective(const Deferred<Eigen::VectorXd, D>& w, double wb,
+                               const Deferred<std::vector<double>, D>& alpha, double diag) {
     double v = w.squaredNorm() + wb * wb;
     for (double a : alpha) v += a * (a * diag - 2.0);
     return 0.5 * v;

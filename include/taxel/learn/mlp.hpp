@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/dataset.hpp"
 
@@ -66,7 +67,10 @@ class Mlp {
 
   /// Trains from a seeded Glorot initialisation. `degenerate` (model unchanged) when the loss
   /// becomes non-finite: lower the learning rate or scale the features.
-  Outcome fit(const DatasetView& d) {
+  template <class D = void>
+  Outcome fit(const Deferred<DatasetView, D>& d) {
+    using Matrix = Deferred<Eigen::MatrixXd, D>;
+    using Vector = Deferred<Eigen::VectorXd, D>;
     Outcome o = validate_training_set(d, "Mlp");
     if (!o) return o;
     std::vector<int> classes = class_order(d.y);
@@ -77,28 +81,28 @@ class Mlp {
     widths.push_back(k);
     const std::size_t nl = widths.size() - 1;
     std::mt19937_64 rng(cfg_.seed);
-    std::vector<Eigen::MatrixXd> w(nl);
-    std::vector<Eigen::VectorXd> b(nl);
+    std::vector<Matrix> w(nl);
+    std::vector<Vector> b(nl);
     for (std::size_t l = 0; l < nl; ++l) {
       const double lim = std::sqrt(6.0 / static_cast<double>(widths[l] + widths[l + 1]));
       std::uniform_real_distribution<double> u(-lim, lim);
-      w[l] = Eigen::MatrixXd::NullaryExpr(widths[l + 1], widths[l], [&] { return u(rng); });
-      b[l] = Eigen::VectorXd::Zero(widths[l + 1]);
+      w[l] = Matrix::NullaryExpr(widths[l + 1], widths[l], [&] { return u(rng); });
+      b[l] = Vector::Zero(widths[l + 1]);
     }
     Eigen::VectorXi target(n);
     for (Eigen::Index i = 0; i < n; ++i)
       target(i) = class_index(classes, d.y[static_cast<std::size_t>(i)]);
     // Optimiser state.
-    std::vector<Eigen::MatrixXd> mw(nl), vw(nl);
-    std::vector<Eigen::VectorXd> mb(nl), vb(nl);
+    std::vector<Matrix> mw(nl), vw(nl);
+    std::vector<Vector> mb(nl), vb(nl);
     for (std::size_t l = 0; l < nl; ++l) {
-      mw[l] = vw[l] = Eigen::MatrixXd::Zero(w[l].rows(), w[l].cols());
-      mb[l] = vb[l] = Eigen::VectorXd::Zero(b[l].size());
+      mw[l] = vw[l] = Matrix::Zero(w[l].rows(), w[l].cols());
+      mb[l] = vb[l] = Vector::Zero(b[l].size());
     }
     std::vector<Eigen::Index> order(static_cast<std::size_t>(n));
     std::iota(order.begin(), order.end(), Eigen::Index{0});
-    std::vector<Eigen::MatrixXd> act(nl + 1);  // activations, one column per sample
-    std::vector<Eigen::MatrixXd> pre(nl);
+    std::vector<Matrix> act(nl + 1);  // activations, one column per sample
+    std::vector<Matrix> pre(nl);
     double best = std::numeric_limits<double>::infinity();
     int stale = 0;
     long long step = 0;
@@ -115,7 +119,7 @@ class Mlp {
           pre[l] = (w[l] * act[l]).colwise() + b[l];
           act[l + 1] = l + 1 < nl ? activate(pre[l]) : softmax(pre[l]);
         }
-        Eigen::MatrixXd delta = act[nl];
+        Matrix delta = act[nl];
         for (Eigen::Index j = 0; j < bs; ++j) {
           const Eigen::Index t = target(order[static_cast<std::size_t>(start + j)]);
           loss -= std::log(std::max(delta(t, j), 1e-300));
@@ -124,8 +128,8 @@ class Mlp {
         delta /= static_cast<double>(bs);
         ++step;
         for (std::size_t l = nl; l-- > 0;) {
-          Eigen::MatrixXd gw = delta * act[l].transpose() + cfg_.l2 * w[l];
-          Eigen::VectorXd gb = delta.rowwise().sum();
+          Matrix gw = delta * act[l].transpose() + cfg_.l2 * w[l];
+          Vector gb = delta.rowwise().sum();
           if (l > 0)
             delta = (w[l].transpose() * delta).cwiseProduct(derivative(pre[l - 1], act[l]));
           update(w[l], gw, mw[l], vw[l], step);
@@ -154,15 +158,17 @@ class Mlp {
   }
 
   /// Class probabilities.
-  void decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
+  template <class D = void>
+  void decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     detail::check_sample(x, dims(), "Mlp");
-    Eigen::MatrixXd a = x;
+    Deferred<Eigen::MatrixXd, D> a = x;
     for (std::size_t l = 0; l < w_.size(); ++l) {
-      const Eigen::MatrixXd z = (w_[l] * a).colwise() + b_[l];
+      const Deferred<Eigen::MatrixXd, D> z = (w_[l] * a).colwise() + b_[l];
       a = l + 1 < w_.size() ? activate(z) : softmax(z);
     }
     out = a.col(0);
   }
+  template <class = void>
   [[nodiscard]] int predict(const SampleRef& x) const {
     Eigen::VectorXd p(static_cast<Eigen::Index>(classes_.size()));
     decision(x, p);
@@ -178,18 +184,20 @@ class Mlp {
   [[nodiscard]] double loss() const noexcept { return loss_; }
 
  private:
-  [[nodiscard]] Eigen::MatrixXd activate(const Eigen::MatrixXd& z) const {
+  template <class M>
+  [[nodiscard]] M activate(const M& z) const {
     if (cfg_.activation == MlpActivation::tanh) return z.array().tanh().matrix();
     return z.cwiseMax(0.0);
   }
   // d act / d z, from the pre-activation z and activation a.
-  [[nodiscard]] Eigen::MatrixXd derivative(const Eigen::MatrixXd& z,
-                                           const Eigen::MatrixXd& a) const {
+  template <class M>
+  [[nodiscard]] M derivative(const M& z, const M& a) const {
     if (cfg_.activation == MlpActivation::tanh) return (1.0 - a.array().square()).matrix();
-    return (z.array() > 0.0).cast<double>().matrix();
+    return (z.array() > 0.0).template cast<double>().matrix();
   }
-  static Eigen::MatrixXd softmax(const Eigen::MatrixXd& z) {
-    Eigen::MatrixXd e = (z.rowwise() - z.colwise().maxCoeff()).array().exp().matrix();
+  template <class M>
+  static M softmax(const M& z) {
+    M e = (z.rowwise() - z.colwise().maxCoeff()).array().exp().matrix();
     return e.array().rowwise() / e.colwise().sum().array();
   }
   template <class M>

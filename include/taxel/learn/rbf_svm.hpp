@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/dataset.hpp"
 
@@ -59,7 +60,8 @@ class RbfSvm {
       bad("max_iterations", static_cast<double>(cfg.max_iterations), "[0, inf)");
   }
 
-  Outcome fit(const DatasetView& d) {
+  template <class D = void>
+  Outcome fit(const Deferred<DatasetView, D>& d) {
     Outcome o = validate_training_set(d, "RbfSvm");
     if (!o) return o;
     std::vector<int> classes = class_order(d.y);
@@ -123,13 +125,15 @@ class RbfSvm {
 
   /// Raw one-vs-one decision values, LIBSVM's order: (0,1), (0,2), ..., (1,2), ...; positive
   /// favours the first class of the pair.
-  void pair_decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
+  template <class D = void>
+  void pair_decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     detail::check_sample(x, dims(), "RbfSvm");
     const std::size_t k = classes_.size();
     if (out.size() != static_cast<Eigen::Index>(k * (k - 1) / 2)) {
       throw std::invalid_argument("RbfSvm::pair_decision: the output needs k(k-1)/2 entries");
     }
-    const Eigen::VectorXd kv =
+    const VectorXd kv =
         (-gamma_ * ((sv_sq_.array() + x.squaredNorm()) - 2.0 * (sv_ * x).array()).max(0.0)).exp();
     std::size_t p = 0;
     for (std::size_t a = 0; a < k; ++a) {
@@ -149,9 +153,11 @@ class RbfSvm {
   }
 
   /// Votes per class.
-  void decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
+  template <class D = void>
+  void decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     const std::size_t k = classes_.size();
-    Eigen::VectorXd pairs(static_cast<Eigen::Index>(k * (k - 1) / 2));
+    VectorXd pairs(static_cast<Eigen::Index>(k * (k - 1) / 2));
     pair_decision(x, pairs);
     if (out.size() != static_cast<Eigen::Index>(k)) {
       throw std::invalid_argument("RbfSvm::decision: the output needs one entry per class");
@@ -164,8 +170,10 @@ class RbfSvm {
       }
     }
   }
-  [[nodiscard]] int predict(const SampleRef& x) const {
-    Eigen::VectorXd votes(static_cast<Eigen::Index>(classes_.size()));
+  template <class D = void>
+  [[nodiscard]] int predict(const Deferred<SampleRef, D>& x) const {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
+    VectorXd votes(static_cast<Eigen::Index>(classes_.size()));
     decision(x, votes);
     Eigen::Index best = 0;
     for (Eigen::Index c = 1; c < votes.size(); ++c) {

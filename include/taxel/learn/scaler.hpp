@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/concepts.hpp"
 #include "taxel/learn/dataset.hpp"
@@ -21,11 +22,13 @@ namespace taxel::learn {
 class AffineScaler {
  public:
   /// Applies the map to one sample. Throws std::invalid_argument on a length mismatch.
-  void transform(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
+  template <class D = void>
+  void transform(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     check(x.size());
     out = (x - offset_).cwiseProduct(factor_);
   }
   /// Applies the map to every row, in place.
+  template <class = void>
   void transform_in_place(Eigen::Ref<FeatureMatrix> x) const {
     check(x.cols());
     x = (x.rowwise() - offset_.transpose()).array().rowwise() * factor_.transpose().array();
@@ -38,6 +41,7 @@ class AffineScaler {
   [[nodiscard]] Eigen::Index dims() const noexcept { return offset_.size(); }
 
  protected:
+  template <class = void>
   void check(Eigen::Index n) const {
     if (dims() == 0) throw std::logic_error("scaler: transform before fit");
     if (n != dims()) {
@@ -45,7 +49,8 @@ class AffineScaler {
                                   " features, the scaler was fitted on " + std::to_string(dims()));
     }
   }
-  static Outcome check_fit(const Eigen::Ref<const FeatureMatrix>& x, const char* who) {
+  template <class D = void>
+  static Outcome check_fit(const Deferred<Eigen::Ref<const FeatureMatrix>, D>& x, const char* who) {
     if (x.rows() == 0 || x.cols() == 0)
       return {Status::invalid_input, std::string(who) + ": no data"};
     if (!x.allFinite()) return {Status::invalid_input, std::string(who) + ": non-finite feature"};
@@ -60,13 +65,14 @@ class AffineScaler {
 class StandardScaler : public AffineScaler {
  public:
   /// Fits on the rows of `x`; `invalid_input` for empty or non-finite data.
-  Outcome fit(const Eigen::Ref<const FeatureMatrix>& x) {
+  template <class D = void>
+  Outcome fit(const Deferred<Eigen::Ref<const FeatureMatrix>, D>& x) {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     Outcome o = check_fit(x, "StandardScaler");
     if (!o) return o;
     offset_ = x.colwise().mean().transpose();
-    const Eigen::VectorXd var =
-        (x.rowwise() - offset_.transpose()).colwise().squaredNorm().transpose() /
-        static_cast<double>(x.rows());
+    const VectorXd var = (x.rowwise() - offset_.transpose()).colwise().squaredNorm().transpose() /
+                         static_cast<double>(x.rows());
     factor_.resize(var.size());
     for (Eigen::Index j = 0; j < var.size(); ++j) {
       const double sd = std::sqrt(var(j));
@@ -88,11 +94,13 @@ class RangeScaler : public AffineScaler {
     }
   }
   /// Fits on the rows of `x`; `invalid_input` for empty or non-finite data.
-  Outcome fit(const Eigen::Ref<const FeatureMatrix>& x) {
+  template <class D = void>
+  Outcome fit(const Deferred<Eigen::Ref<const FeatureMatrix>, D>& x) {
+    using VectorXd = Deferred<Eigen::VectorXd, D>;
     Outcome o = check_fit(x, "RangeScaler");
     if (!o) return o;
-    const Eigen::VectorXd lo = x.colwise().minCoeff().transpose();
-    const Eigen::VectorXd hi = x.colwise().maxCoeff().transpose();
+    const VectorXd lo = x.colwise().minCoeff().transpose();
+    const VectorXd hi = x.colwise().maxCoeff().transpose();
     offset_.resize(lo.size());
     factor_.resize(lo.size());
     for (Eigen::Index j = 0; j < lo.size(); ++j) {

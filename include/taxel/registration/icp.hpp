@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/point_cloud.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/registration/kernels.hpp"
@@ -91,8 +92,10 @@ struct PointToPoint {
   [[nodiscard]] static double residual(const Correspondence& c) noexcept { return std::sqrt(c.d2); }
 
   /// The update `delta` (applied on the left) minimising the weighted error, or `degenerate`
-  /// when the source points are collinear.
-  static Outcome solve(std::span<const Correspondence> cs, Isometry3d& delta) {
+  /// when the source points are collinear. (A template only so that the Eigen solvers it uses
+  /// are compiled by the translation units that call it, not by every one that includes ICP.)
+  template <class D = void>
+  static Outcome solve(std::span<const Deferred<Correspondence, D>> cs, Isometry3d& delta) {
     double wsum = 0.0;
     Vec3d pm = Vec3d::Zero(), qm = Vec3d::Zero();
     for (const auto& c : cs) {
@@ -136,7 +139,8 @@ struct PointToPoint {
   }
 
   /// Adds J'J of the 3-D residual p - q (J = [-[p]x, I]).
-  static void add_information(const Correspondence& c, Mat6d& info) {
+  template <class D = void>
+  static void add_information(const Deferred<Correspondence, D>& c, Mat6d& info) {
     Eigen::Matrix<double, 3, 6> j;
     j.leftCols<3>() << 0.0, c.p.z(), -c.p.y(), -c.p.z(), 0.0, c.p.x(), c.p.y(), -c.p.x(), 0.0;
     j.rightCols<3>().setIdentity();
@@ -153,11 +157,15 @@ struct PointToPlane {
   static constexpr std::size_t min_correspondences = 6;
   static constexpr double kFreeDirection = 1e-6;
 
-  [[nodiscard]] static double residual(const Correspondence& c) noexcept {
+  template <class D = void>
+  [[nodiscard]] static double residual(const Deferred<Correspondence, D>& c) noexcept {
     return std::fabs(c.n.dot(c.p - c.q));
   }
 
-  static Outcome solve(std::span<const Correspondence> cs, Isometry3d& delta) {
+  /// The Gauss-Newton update (a template only to defer compiling its Eigen solvers).
+  template <class D = void>
+  static Outcome solve(std::span<const Deferred<Correspondence, D>> cs, Isometry3d& delta) {
+    using MatrixXd = Deferred<Eigen::MatrixXd, D>;
     double wsum = 0.0;
     Vec3d centre = Vec3d::Zero();
     for (const auto& c : cs) {
@@ -179,12 +187,12 @@ struct PointToPlane {
     Vec6d g = Vec6d::Zero();
     for (const auto& c : cs) {
       Vec6d j;
-      j.head<3>() = (c.p - centre).cross(c.n) / len;
-      j.tail<3>() = c.n;
+      j.template head<3>() = (c.p - centre).cross(c.n) / len;
+      j.template tail<3>() = c.n;
       const double r = c.n.dot(c.p - c.q);
       h.noalias() += (c.weight * j) * j.transpose();
       g.noalias() += (c.weight * r) * j;
-      j.head<3>() = (c.q - centre).cross(c.n) / len;
+      j.template head<3>() = (c.q - centre).cross(c.n) / len;
       hq.noalias() += (c.weight * j) * j.transpose();
     }
     const Eigen::SelfAdjointEigenSolver<Mat6d> eig(hq);
@@ -197,11 +205,11 @@ struct PointToPlane {
       x = -h.ldlt().solve(g);
     } else {  // Newton step within the constrained subspace N: x = -N (N'hN)^-1 N'g
       const auto n = eig.eigenvectors().rightCols(6 - free);
-      const Eigen::MatrixXd reduced = n.transpose() * h * n;
+      const MatrixXd reduced = n.transpose() * h * n;
       x = -n * reduced.ldlt().solve(n.transpose() * g);
     }
-    const Vec3d omega = x.head<3>() / len;
-    const Vec3d v = x.tail<3>();
+    const Vec3d omega = x.template head<3>() / len;
+    const Vec3d v = x.template tail<3>();
     const double angle = omega.norm();
     const Mat3d r = angle > 0.0 ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix()
                                 : Mat3d::Identity();
@@ -219,10 +227,11 @@ struct PointToPlane {
   }
 
   /// Adds J'J of the scalar residual n . (p - q) (J = [p x n, n]).
-  static void add_information(const Correspondence& c, Mat6d& info) {
+  template <class D = void>
+  static void add_information(const Deferred<Correspondence, D>& c, Mat6d& info) {
     Vec6d j;
-    j.head<3>() = c.p.cross(c.n);
-    j.tail<3>() = c.n;
+    j.template head<3>() = c.p.cross(c.n);
+    j.template tail<3>() = c.n;
     info.selfadjointView<Eigen::Lower>().rankUpdate(j);
   }
 };

@@ -31,6 +31,7 @@ namespace taxel::registration {
 
 /// The 24 proper rotations that map the coordinate axes onto themselves (signed permutation
 /// matrices with determinant +1), identity first.
+template <class = void>
 inline std::vector<Mat3d> cube_rotations() {
   std::vector<Mat3d> out;
   const std::array<std::array<int, 3>, 6> perms{

@@ -109,6 +109,7 @@ class ContactExtractor {
   /// `T_world_pad` (pad -> world, as the robot believes it) at `time` [s] to `out`, in row-major
   /// tactel order. Returns the number appended. Throws std::invalid_argument when `counts`
   /// does not match the pad geometry or the pose is not finite.
+  template <class = void>
   std::size_t extract(const PadMatrix& counts, const Eigen::Isometry3d& T_world_pad, double time,
                       std::vector<Contact<double>>& out) {
     const PadGeometry& g = model_.geometry;
@@ -156,6 +157,7 @@ class ContactExtractor {
 
   // The contact at pad point (x, y, -depth) with outward normal n_pad (pad frame), extra
   // variance along the normal and the slope variances of that normal.
+  template <class = void>
   Contact<double> make(const Eigen::Isometry3d& T, double x, double y, double depth,
                        const Vec3d& n_pad, double var_along, double var_across, double slope_var,
                        double pressure, double time) const {
@@ -174,6 +176,7 @@ class ContactExtractor {
     return c;
   }
 
+  template <class = void>
   std::size_t per_tactel(const PadMatrix& counts, const Eigen::Isometry3d& T, double time,
                          std::vector<Contact<double>>& out) const {
     const PadGeometry& g = model_.geometry;
@@ -243,6 +246,7 @@ class ContactExtractor {
 
   double q2() const { return model_.geometry.pitch * model_.geometry.pitch / 12.0; }
 
+  template <class = void>
   std::size_t per_pad(const PadMatrix& counts, const Eigen::Isometry3d& T, double time,
                       std::vector<Contact<double>>& out) const {
     const PadGeometry& g = model_.geometry;

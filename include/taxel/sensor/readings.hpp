@@ -46,6 +46,7 @@ struct ReadingStack {
     return s;
   }
   /// The readings of pad `pad` in frame `frame`, as a rows x cols matrix.
+  template <class = void>
   PadMatrix pad(std::size_t frame, std::size_t pad) const {
     PadMatrix m(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
     const std::size_t n = rows * cols;
@@ -68,6 +69,7 @@ struct ReadingsSummary {
 /// columns differ from the stack's, when a pose names a frame or pad outside the stack, or
 /// when a pad with readings above the threshold has no pose (its contacts could not be
 /// placed); the message names the frame and pad.
+template <class = void>
 inline ReadingsSummary contacts_from_readings(const ReadingStack& stack,
                                               std::span<const io::PadPose> poses,
                                               const SensorModel& model,

@@ -34,6 +34,7 @@ struct ExplorationConfig {
   std::uint64_t seed = 1;                                         ///< equal seeds, equal output
 
   /// Throws std::invalid_argument naming the first parameter out of range.
+  template <class = void>
   void validate() const {
     sensor.validate();
     contacts.validate();
@@ -110,6 +111,7 @@ namespace detail {
 
 /// Pad pose with face normal `z` (looking into the object), long side (pad y) along `y`
 /// (orthogonalised), at `origin`.
+template <class = void>
 inline Eigen::Isometry3d pad_pose(const Vec3d& z, const Vec3d& y_hint, const Vec3d& origin) {
   Vec3d y = y_hint - y_hint.dot(z) * z;
   y = y.norm() > 1e-9 ? Vec3d(y.normalized()) : z.unitOrthogonal();

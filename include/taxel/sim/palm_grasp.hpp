@@ -168,6 +168,7 @@ class PalmGraspSynth {
   }
 
   /// One grasp image.
+  template <class = void>
   [[nodiscard]] image::ImageD render(const Subject& s, GraspClass cls, bool right_hand,
                                      int grasp) const {
     std::mt19937_64 rng(mix(seed_, static_cast<std::uint64_t>(s.id),
@@ -258,6 +259,7 @@ class PalmGraspSynth {
 
   /// A data set of `subjects` x 4 classes x `grasps` x 2 hands, ordered subject, class, grasp,
   /// hand (right first).
+  template <class = void>
   [[nodiscard]] std::vector<PalmGraspSample> dataset(int subjects, int grasps) const {
     std::vector<PalmGraspSample> out;
     out.reserve(static_cast<std::size_t>(std::max(0, subjects * grasps * 8)));

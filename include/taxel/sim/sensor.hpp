@@ -131,6 +131,7 @@ PadReading read_pad(const Sh& shape, const SensorModel& model, const Eigen::Isom
 /// by the measurement model of sensor/contacts.hpp (`sensor::ContactExtractor`). Builds the
 /// extractor's workspace on every call: a loop over many frames should keep one extractor.
 /// Returns the number of contacts appended.
+template <class = void>
 inline std::size_t pad_contacts(const PadReading& reading, const SensorModel& model,
                                 const sensor::ContactOptions& options, double time,
                                 std::vector<Contact<double>>& out) {
@@ -139,6 +140,7 @@ inline std::size_t pad_contacts(const PadReading& reading, const SensorModel& mo
 }
 
 /// As above with the default options and the given contact mode.
+template <class = void>
 inline std::size_t pad_contacts(const PadReading& reading, const SensorModel& model,
                                 ContactMode mode, double time, std::vector<Contact<double>>& out) {
   return pad_contacts(reading, model, sensor::ContactOptions{.mode = mode}, time, out);

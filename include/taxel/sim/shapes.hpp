@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "taxel/core/deferred.hpp"
 #include "taxel/core/types.hpp"
 
 namespace taxel::sim {
@@ -36,12 +37,19 @@ struct Sphere {
   explicit Sphere(double r = 0.04) : radius(r) {
     if (!(r > 0) || !std::isfinite(r)) throw std::invalid_argument("Sphere: radius must be > 0");
   }
-  double signed_distance(const Vec3d& p) const { return p.norm() - radius; }
-  Vec3d normal(const Vec3d& p) const {
+  template <class D = void>
+  double signed_distance(const Deferred<Vec3d, D>& p) const {
+    return p.norm() - radius;
+  }
+  template <class D = void>
+  Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const double n = p.norm();
     return n > 0 ? Vec3d(p / n) : Vec3d::UnitZ();
   }
-  Vec3d closest_point(const Vec3d& p) const { return radius * normal(p); }
+  template <class D = void>
+  Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
+    return radius * normal(p);
+  }
 };
 
 /// Capped cylinder along z, centred at the origin: radius and half height [m].
@@ -55,13 +63,15 @@ struct Cylinder {
       throw std::invalid_argument("Cylinder: radius and half_height must be > 0");
     }
   }
-  double signed_distance(const Vec3d& p) const {
+  template <class D = void>
+  double signed_distance(const Deferred<Vec3d, D>& p) const {
     const double dr = std::hypot(p.x(), p.y()) - radius;
     const double dz = std::abs(p.z()) - half_height;
     const double out = std::hypot(std::max(dr, 0.0), std::max(dz, 0.0));
     return std::min(std::max(dr, dz), 0.0) + out;
   }
-  Vec3d closest_point(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     const double r = std::hypot(p.x(), p.y());
     const Vec3d radial = r > 0 ? Vec3d(p.x() / r, p.y() / r, 0) : Vec3d::UnitX();
     const double dr = r - radius;
@@ -74,7 +84,8 @@ struct Cylinder {
     const double rc = std::min(r, radius);
     return Vec3d(radial.x() * rc, radial.y() * rc, std::clamp(p.z(), -half_height, half_height));
   }
-  Vec3d normal(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = closest_point(p);
     const double r = std::hypot(c.x(), c.y());
     const bool on_side = std::abs(r - radius) <= 1e-12 * radius;
@@ -99,11 +110,13 @@ struct Box {
       throw std::invalid_argument("Box: half extents must be > 0");
     }
   }
-  double signed_distance(const Vec3d& p) const {
+  template <class D = void>
+  double signed_distance(const Deferred<Vec3d, D>& p) const {
     const Vec3d d = p.cwiseAbs() - half_extents;
     return d.cwiseMax(0.0).norm() + std::min(d.maxCoeff(), 0.0);
   }
-  Vec3d closest_point(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     const Vec3d d = p.cwiseAbs() - half_extents;
     if ((d.array() <= 0).all()) {  // inside: push to the nearest face
       Eigen::Index axis;
@@ -114,7 +127,8 @@ struct Box {
     }
     return p.cwiseMax(-half_extents).cwiseMin(half_extents);
   }
-  Vec3d normal(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = closest_point(p);
     const Vec3d d = p - c;
     if (d.norm() > 1e-12 && signed_distance(p) > 0) return d.normalized();
@@ -138,12 +152,17 @@ struct Cone {
       throw std::invalid_argument("Cone: radius and height must be > 0");
     }
   }
-  double signed_distance(const Vec3d& p) const {
+  template <class D = void>
+  double signed_distance(const Deferred<Vec3d, D>& p) const {
     const Section s = section(p);
     return s.inside ? -s.distance : s.distance;
   }
-  Vec3d closest_point(const Vec3d& p) const { return lift(p, section(p).closest); }
-  Vec3d normal(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
+    return lift(p, section(p).closest);
+  }
+  template <class D = void>
+  Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Section s = section(p);
     Eigen::Vector2d n2;                           // outward normal in the (r, z) half-plane
     const Eigen::Vector2d slant(height, radius);  // normal of the slanted side, unnormalised
@@ -174,7 +193,8 @@ struct Cone {
   };
   // The closest point of the triangle (0, -h/2), (R, -h/2), (0, h/2) boundary, without the
   // axis edge, to (r, z).
-  Section section(const Vec3d& p) const {
+  template <class D = void>
+  Section section(const Deferred<Vec3d, D>& p) const {
     Section s;
     s.query = {std::hypot(p.x(), p.y()), p.z()};
     const Eigen::Vector2d base0(0.0, -0.5 * height), rim(radius, -0.5 * height),
@@ -202,7 +222,8 @@ struct Cone {
                s.query.x() / radius + (s.query.y() + 0.5 * height) / height < 1.0;
     return s;
   }
-  static Vec3d lift(const Vec3d& p, const Eigen::Vector2d& rz) {
+  template <class D = void>
+  static Vec3d lift(const Deferred<Vec3d, D>& p, const Eigen::Vector2d& rz) {
     const double r = std::hypot(p.x(), p.y());
     const Vec3d radial = r > 0 ? Vec3d(p.x() / r, p.y() / r, 0) : Vec3d::UnitX();
     return rz.x() * radial + Vec3d(0, 0, rz.y());
@@ -225,11 +246,13 @@ struct Ellipsoid {
       throw std::invalid_argument("Ellipsoid: semi-axes must be finite and > 0");
     }
   }
-  double signed_distance(const Vec3d& p) const {
+  template <class D = void>
+  double signed_distance(const Deferred<Vec3d, D>& p) const {
     const double d = (p - closest_point(p)).norm();
     return p.cwiseQuotient(semi_axes).squaredNorm() < 1.0 ? -d : d;
   }
-  Vec3d closest_point(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     const Vec3d& e = semi_axes;
     // Work in the first octant; a coordinate on a symmetry plane is nudged off it so that F has
     // its pole (the far branch of the inside case picks one of two mirror-image answers).
@@ -265,7 +288,8 @@ struct Ellipsoid {
     for (int i = 0; i < 3; ++i) x[i] = std::copysign(x[i], p[i]);
     return x;
   }
-  Vec3d normal(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = closest_point(p);
     return c.cwiseQuotient(semi_axes.cwiseProduct(semi_axes)).normalized();
   }
@@ -285,9 +309,16 @@ struct Torus {
           "Torus: radii must be finite with 0 < minor_radius < major_radius");
     }
   }
-  double signed_distance(const Vec3d& p) const { return (p - centre(p)).norm() - minor_radius; }
-  Vec3d closest_point(const Vec3d& p) const { return centre(p) + minor_radius * normal(p); }
-  Vec3d normal(const Vec3d& p) const {
+  template <class D = void>
+  double signed_distance(const Deferred<Vec3d, D>& p) const {
+    return (p - centre(p)).norm() - minor_radius;
+  }
+  template <class D = void>
+  Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
+    return centre(p) + minor_radius * normal(p);
+  }
+  template <class D = void>
+  Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = centre(p);
     const Vec3d d = p - c;
     const double n = d.norm();
@@ -297,7 +328,8 @@ struct Torus {
 
  private:
   // The nearest point of the tube's centre circle (any, on the axis).
-  Vec3d centre(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d centre(const Deferred<Vec3d, D>& p) const {
     const double r = std::hypot(p.x(), p.y());
     const Vec3d radial = r > 0 ? Vec3d(p.x() / r, p.y() / r, 0) : Vec3d::UnitX();
     return major_radius * radial;
@@ -314,6 +346,7 @@ class TriangleMesh {
 
   /// Throws std::invalid_argument for no triangles, an index out of range, a non-finite vertex
   /// or a triangle of zero area.
+  template <class = void>
   TriangleMesh(std::vector<Vec3d> vertices, std::vector<Triangle> triangles)
       : v_(std::move(vertices)), t_(std::move(triangles)) {
     if (t_.empty()) throw std::invalid_argument("TriangleMesh: no triangles");
@@ -377,15 +410,20 @@ class TriangleMesh {
   /// Unit normal of triangle f.
   [[nodiscard]] const Vec3d& face_normal(std::size_t f) const { return face_normal_.at(f); }
 
-  double signed_distance(const Vec3d& p) const {
+  template <class D = void>
+  double signed_distance(const Deferred<Vec3d, D>& p) const {
     const Hit h = nearest(p);
     const double d = std::sqrt(h.d2);
     return (p - h.point).dot(h.pseudo_normal) < 0.0 ? -d : d;
   }
-  Vec3d closest_point(const Vec3d& p) const { return nearest(p).point; }
+  template <class D = void>
+  Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
+    return nearest(p).point;
+  }
   /// The face normal where the closest point lies inside a face; the pseudo-normal (or the
   /// direction to p) on edges and vertices.
-  Vec3d normal(const Vec3d& p) const {
+  template <class D = void>
+  Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Hit h = nearest(p);
     if (h.feature == 6) return face_normal_[h.face];
     const Vec3d d = p - h.point;
@@ -406,7 +444,8 @@ class TriangleMesh {
     return a < b ? (std::uint64_t{a} << 32) | b : (std::uint64_t{b} << 32) | a;
   }
 
-  Hit nearest(const Vec3d& p) const {
+  template <class D = void>
+  Hit nearest(const Deferred<Vec3d, D>& p) const {
     Hit best;
     for (std::size_t f = 0; f < t_.size(); ++f) {
       int feature = 6;
@@ -429,8 +468,9 @@ class TriangleMesh {
 
   // Closest point of triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5), with
   // the feature it lies on.
-  static Vec3d closest_on_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c,
-                                   int& feature) {
+  template <class D = void>
+  static Vec3d closest_on_triangle(const Deferred<Vec3d, D>& p, const Vec3d& a, const Vec3d& b,
+                                   const Vec3d& c, int& feature) {
     const Vec3d ab = b - a, ac = c - a, ap = p - a;
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);
     if (d1 <= 0 && d2 <= 0) return feature = 0, a;
@@ -463,6 +503,7 @@ class TriangleMesh {
 
 /// A sphere of radius r tessellated as an icosphere: the icosahedron, each triangle split in
 /// four `subdivisions` times, vertices pushed onto the sphere (20 * 4^s triangles).
+template <class = void>
 inline TriangleMesh icosphere(double r, int subdivisions) {
   if (!(r > 0) || subdivisions < 0 || subdivisions > 7) {
     throw std::invalid_argument("icosphere: r must be > 0 and subdivisions in [0, 7]");

@@ -1,0 +1,9 @@
+// SPDX-License-Identifier: MIT
+#include <taxel/sensor.hpp>
+
+#include "units.hpp"
+
+int unit_sensor() {
+  const taxel::sensor::PadGeometry pad;
+  return pad.rows > 0 && pad.cols > 0 ? 0 : 1;
+}
