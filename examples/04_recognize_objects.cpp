@@ -26,14 +26,22 @@ namespace tr = taxel::registration;
 struct Object {
   std::string name;
   std::function<PointCloud<double>(std::size_t, std::uint64_t)> model;
+  std::function<sim::TriangleMesh()> mesh;
   std::function<std::vector<Contact<double>>(std::size_t, const sim::SlidingConfig&)> explore;
 };
+
+// Meshes of very different vertex density: 12 triangles for a box, 2 562 vertices for a
+// sphere, 514 for a cylinder.
+sim::TriangleMesh mesh_of(const sim::Sphere& s) { return sim::icosphere(s.radius, 4); }
+sim::TriangleMesh mesh_of(const sim::Cylinder& c) { return sim::cylinder_mesh(c, 256); }
+sim::TriangleMesh mesh_of(const sim::Box& b) { return sim::box_mesh(b); }
 
 template <class Shape>
 Object make(std::string name, Shape shape) {
   return {
       std::move(name),
       [shape](std::size_t n, std::uint64_t seed) { return sim::sample_surface(shape, n, seed); },
+      [shape] { return mesh_of(shape); },
       [shape](std::size_t n, const sim::SlidingConfig& c) {
         return sim::sliding_exploration(shape, n, c);
       }};
@@ -69,11 +77,17 @@ int main(int argc, char** argv) try {
   };
   std::filesystem::create_directories(out / "models");
   std::filesystem::create_directories(out / "clouds");
+  std::filesystem::create_directories(out / "meshes");
   tr::ObjectLibrary<double> lib;
   for (const auto& o : objects) {
     const PointCloud<double> m = o.model(10000, 1);
     lib.add(o.name, m);
     io::write_ply((out / "models" / (o.name + ".ply")).string(), m);
+    const sim::TriangleMesh mesh = o.mesh();
+    PointCloud<double> vertices;
+    vertices.points = mesh.vertices();
+    io::write_ply((out / "meshes" / (o.name + ".ply")).string(), vertices,
+                  io::PlyFormat::binary_little_endian, mesh.triangles());
   }
 
   const std::size_t n = objects.size();
@@ -129,9 +143,9 @@ int main(int argc, char** argv) try {
   std::printf("top-1 %d / %d = %.1f %%, %.1f ms per recognition among %zu models\n", right, total,
               100.0 * right / total, 1e3 * seconds / total, n);
   std::printf(
-      "wrote %s/models/*.ply and %s/clouds/*.ply (try: taxel-recognize %s/clouds/cube-50.ply "
-      "%s/models)\n",
-      out.c_str(), out.c_str(), out.c_str(), out.c_str());
+      "wrote %s/models/*.ply, %s/meshes/*.ply and %s/clouds/*.ply (try: taxel-recognize "
+      "%s/clouds/cube-50.ply %s/meshes)\n",
+      out.c_str(), out.c_str(), out.c_str(), out.c_str(), out.c_str());
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "04_recognize_objects: %s\n", e.what());

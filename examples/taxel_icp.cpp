@@ -22,8 +22,10 @@ constexpr const char* kUsage = R"usage(usage: taxel-icp [options] SOURCE.ply TAR
 
 Aligns SOURCE to TARGET with ICP and prints T_target_source (4 rows of 4 numbers), then
 "rmse", "fitness" (inlier fraction), "iterations" and "status" lines. The target's normals
-come from its file or, when it has none, from PCA over its nearest neighbours. Distances are
-in the files' unit (taxel uses metres).
+come from its file or, when it has none, from PCA over its nearest neighbours. A TARGET with
+faces (a mesh) stands for its surface: points drawn uniformly over it by area, about one per
+--mesh-spacing squared, with the faces' normals (a line on standard error says so); SOURCE is
+used as its vertices. Distances are in the files' unit (taxel uses metres).
 
 options:
   --method point-to-plane|point-to-point   error (default point-to-plane)
@@ -38,6 +40,8 @@ options:
   --normal-neighbors K  neighbours of the PCA normals (default 12)
   --scale F             multiply both clouds' coordinates by F first (--scale 0.001 for files
                         in millimetres); the transform, distances and -o are then in metres
+  --mesh-spacing D      sample a TARGET mesh at about one point per D^2 (default 0.001;
+                        0: use its vertices only)
   -o FILE               also write the aligned source as PLY
   -h, --help            show this help
   --version             show taxel's version
@@ -63,6 +67,7 @@ struct Options {
   taxel::Isometry3d init = taxel::Isometry3d::Identity();
   int normal_neighbors = 12;
   double scale = 1.0;
+  double mesh_spacing = 1e-3;
   std::string output;
   std::vector<std::string> inputs;
 };
@@ -116,6 +121,8 @@ Options parse(taxel_cli::Args& args) {
       o.normal_neighbors = args.number<int>(3, 1000);
     } else if (a == "--scale") {
       o.scale = args.number<double>(1e-300, 1e300);
+    } else if (a == "--mesh-spacing") {
+      o.mesh_spacing = args.number<double>(0.0, 1e300);
     } else if (a == "-o") {
       o.output = std::string(args.value());
     } else if (a.size() > 1 && a[0] == '-') {
@@ -169,10 +176,19 @@ int main(int argc, char** argv) {
                                  taxel_cli::largest_extent(source.cloud.points));
   taxel_cli::warn_if_millimetres("taxel-icp", opt.inputs[1],
                                  taxel_cli::largest_extent(target.cloud.points));
+  tr::ModelCloud model;
+  try {  // a mesh becomes its surface (after scaling: the spacing is in metres)
+    model = tr::model_cloud(std::move(target), {.spacing = opt.mesh_spacing});
+  } catch (const std::invalid_argument& e) {
+    args.fail(opt.inputs[1] + ": " + e.what(), 1);
+  }
+  if (model.from_surface) {
+    std::fprintf(stderr, "taxel-icp: %s: %s\n", opt.inputs[1].c_str(), model.describe().c_str());
+  }
   tr::IcpResult r;
   std::optional<tr::Target<double>> tg_storage;
   try {  // a model Target refuses (points too far apart to grid, bad normals) is bad data
-    tg_storage.emplace(std::move(target.cloud),
+    tg_storage.emplace(std::move(model.cloud),
                        tr::TargetConfig{.normal_neighbors = opt.normal_neighbors});
   } catch (const std::invalid_argument& e) {
     args.fail(opt.inputs[1] + ": " + e.what(), 1);

@@ -27,7 +27,10 @@ Recognises the object a tactile cloud was taken from: every MODEL (a .ply file, 
 whose .ply files are all models; the name is the file name without .ply) is aligned to the
 cloud from 28 starts (4 principal-axes, 24 cube rotations) and scored by the truncated RMS
 distance of the cloud's points to it. Prints the ranking, best first, then the answer: the best
-model's name, or "unknown" when even it scores above --unknown. Distances in metres.
+model's name, or "unknown" when even it scores above --unknown. Distances in metres. A PLY
+with faces (a mesh) stands for its surface: points drawn uniformly over it by area, about one
+per --mesh-spacing squared, so a finely and a coarsely meshed model weigh alike; one line on
+standard error says so for each.
 
 options:
   --unknown D        answer unknown above this score (default 0.003)
@@ -36,6 +39,8 @@ options:
   --format text|json (default text)
   --scale F          multiply the cloud's and the models' coordinates by F first
                      (--scale 0.001 for files in millimetres)
+  --mesh-spacing D   sample meshes at about one point per D^2 (default 0.001; 0: use
+                     their vertices only)
   -h, --help         show this help
   --version          show taxel's version
 
@@ -53,6 +58,7 @@ int main(int argc, char** argv) {
   tr::LibraryConfig cfg;
   bool json = false;
   double scale = 1.0;
+  tr::ModelSampling sampling;
   std::vector<std::string> inputs;
   std::string_view a;
   while (args.next(a)) {
@@ -67,6 +73,8 @@ int main(int argc, char** argv) {
       cfg.rotation_starts = args.number<int>(-1000, 1000);
     } else if (a == "--scale") {
       scale = args.number<double>(1e-300, 1e300);
+    } else if (a == "--mesh-spacing") {
+      sampling.spacing = args.number<double>(0.0, 1e300);
     } else if (a == "--format") {
       const auto v = args.value();
       if (v != "text" && v != "json") die("--format must be text or json");
@@ -105,13 +113,23 @@ int main(int argc, char** argv) {
   }
   try {
     // Scaled, and checked for millimetres (a tactile object spans centimetres).
+    // Meshes become their surface (after scaling: the spacing is in metres).
     const auto load = [&](const std::string& path) {
-      taxel::PointCloud<double> c = taxel::io::read_ply(path).cloud;
+      taxel::io::PlyData ply = taxel::io::read_ply(path);
       if (scale != 1.0) {
-        for (auto& p : c.points) p *= scale;
+        for (auto& p : ply.cloud.points) p *= scale;
       }
-      taxel_cli::warn_if_millimetres("taxel-recognize", path, taxel_cli::largest_extent(c.points));
-      return c;
+      taxel_cli::warn_if_millimetres("taxel-recognize", path,
+                                     taxel_cli::largest_extent(ply.cloud.points));
+      tr::ModelCloud m;
+      try {
+        m = tr::model_cloud(std::move(ply), sampling);
+      } catch (const std::invalid_argument& e) {
+        die(path + ": " + e.what(), 1);
+      }
+      if (m.from_surface)
+        std::fprintf(stderr, "taxel-recognize: %s: %s\n", path.c_str(), m.describe().c_str());
+      return std::move(m.cloud);
     };
     for (const auto& m : models) {
       try {

@@ -3,10 +3,12 @@
 // and, optionally, the ground-truth surface as PLY.
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -41,6 +43,8 @@ options:
                      box: half extents (0.04,0.03,0.02); cone: radius, height (0.03,0.06);
                      ellipsoid: semi-axes (0.05,0.035,0.025); torus: R, r (0.04,0.015)
   --mesh FILE.ply    the mesh of --shape mesh (closed, outward-oriented triangles)
+  --scale F          multiply the mesh's coordinates by F first (--scale 0.001 for a mesh
+                     in millimetres)
   --pose X,Y,Z[,RX,RY,RZ]  the object's position and rotation vector (default the origin)
   --exploration sliding|grasp|palpation   (default sliding)
   --contacts N       stop after N contacts, exploring further as needed (default 20000;
@@ -73,6 +77,7 @@ struct Options {
   std::string shape = "sphere";
   std::vector<double> size;
   std::string mesh;
+  double scale = 1.0;
   std::string exploration = "sliding";
   std::size_t contacts = 20000;
   ts::ExplorationConfig config;
@@ -123,9 +128,18 @@ ts::Exploration<Shape> explore(const Options& o, const Shape& shape, std::size_t
     p.touches *= static_cast<int>(scale);
     return ts::explore_palpation(shape, o.config, p);
   };
+  // A longer exploration until it has enough contacts; on long runs, progress on stderr.
+  const auto start = std::chrono::steady_clock::now();
   for (std::size_t scale = 1;; scale *= 2) {
     ts::Exploration<Shape> ex = once(scale);
     if (ex.contact_count() >= want || scale >= 64) return ex;
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (s > 1.0) {
+      std::fprintf(stderr,
+                   "taxel-simulate: %zu of %zu contacts after %.1f s; exploring %zux longer\n",
+                   ex.contact_count(), want, s, 2 * scale);
+    }
   }
 }
 
@@ -196,6 +210,8 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--size") {
       o.size = numbers(args, "--size", args.value());
+    } else if (a == "--scale") {
+      o.scale = args.number<double>(1e-300, 1e300);
     } else if (a == "--mesh") {
       o.mesh = std::string(args.value());
     } else if (a == "--pose") {
@@ -273,6 +289,7 @@ int main(int argc, char** argv) {
     args.fail("expected CONTACTS.csv [TRUTH.ply] (see --help)");
   if (o.shape == "mesh" && o.mesh.empty()) args.fail("--shape mesh needs --mesh FILE.ply");
   if (o.shape != "mesh" && !o.mesh.empty()) args.fail("--mesh is only used with --shape mesh");
+  if (o.shape != "mesh" && o.scale != 1.0) args.fail("--scale is only used with --shape mesh");
   const auto dims = [&](std::size_t n, std::vector<double> fallback) {
     if (o.size.empty()) return fallback;
     if (o.size.size() != n) {
@@ -310,7 +327,18 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
       args.fail(e.what(), 1);
     }
-    return run(o, ts::TriangleMesh(ply.cloud.points, ply.triangles), args);
+    if (o.scale != 1.0) {
+      for (auto& p : ply.cloud.points) p *= o.scale;
+    }
+    taxel_cli::warn_if_millimetres("taxel-simulate", o.mesh,
+                                   taxel_cli::largest_extent(ply.cloud.points));
+    std::optional<ts::TriangleMesh> mesh;
+    try {
+      mesh.emplace(std::move(ply.cloud.points), std::move(ply.triangles));
+    } catch (const std::invalid_argument& e) {  // a mesh TriangleMesh refuses is bad data
+      args.fail(o.mesh + ": " + e.what(), 1);
+    }
+    return run(o, *mesh, args);
   } catch (const std::invalid_argument& e) {  // a shape or exploration parameter out of range
     args.fail(e.what());
   }

@@ -37,6 +37,8 @@ run_tool("${TOOL}" 2 --policy median contacts.csv x.ply)
 expect("${err}" "--policy must be surfel, kalman, average or raw")
 run_tool("${TOOL}" 2 --radius -1 contacts.csv x.ply)
 expect("${err}" "association_radius")
+run_tool("${TOOL}" 2 --radius 4 contacts.csv x.ply)  # millimetres
+expect("${err}" "looks like millimetres; taxel uses metres")
 run_tool("${TOOL}" 2 contacts.csv)
 expect("${err}" "expected CONTACTS.csv and CLOUD.ply")
 file(WRITE "${WORK_DIR}/bad.csv" "x,y,z\n1,2,3\n1,2\n")
@@ -77,6 +79,20 @@ file(WRITE "${WORK_DIR}/tet.ply" "ply\nformat ascii 1.0\nelement vertex 4\nprope
      "3 0 3 2\n3 1 2 3\n")
 run_tool("${SIMULATE}" 0 --shape mesh --mesh tet.ply --contacts 500 tet.csv)
 expect("${out}" "shape mesh\nexploration sliding\ncontacts 500\n")
+# The same tetrahedron in millimetres: the warning with the fix; --scale 0.001 is the fix.
+file(WRITE "${WORK_DIR}/tet_mm.ply" "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\n"
+     "property double y\nproperty double z\nelement face 4\nproperty list uchar int "
+     "vertex_indices\nend_header\n0 0 0\n50 0 0\n0 50 0\n0 0 50\n3 0 2 1\n3 0 1 3\n"
+     "3 0 3 2\n3 1 2 3\n")
+run_tool("${SIMULATE}" 0 --shape mesh --mesh tet_mm.ply --contacts 500 tet_mm.csv)
+expect("${err}" "tet_mm.ply spans 50 along one axis: its coordinates look like millimetres")
+run_tool("${SIMULATE}" 0 --shape mesh --mesh tet_mm.ply --scale 0.001 --contacts 500 tet_mm.csv)
+expect("${out}" "contacts 500\n")
+if(err MATCHES "millimetres")
+  message(FATAL_ERROR "taxel-simulate --scale 0.001 still warns:\n${err}")
+endif()
+run_tool("${SIMULATE}" 2 --shape box --scale 0.001 x.csv)
+expect("${err}" "--scale is only used with --shape mesh")
 # Grasps and palpation, per pad, with the object at a pose: the contacts are there.
 run_tool("${SIMULATE}" 0 --shape cylinder --exploration grasp --per-pad --contacts 0 --grasps 2
          --pose 0.5,0,0 grasp.csv grasp_truth.ply)

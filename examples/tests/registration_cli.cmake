@@ -98,3 +98,23 @@ if(err MATCHES "millimetres")
 endif()
 run_tool("${RECOGNIZE}" 0 --starts 0 mm.ply mm.ply)
 expect("${err}" "--scale 0.001")
+
+# Meshes: a PLY with faces stands for its surface. 04_recognize_objects wrote the same seven
+# objects as meshes of very uneven vertex density (12 triangles for a box, 2 562 vertices for a
+# sphere): recognised by their surfaces, the box cloud is the box.
+run_tool("${RECOGNIZE}" 0 rec/clouds/box-80x60x40.ply rec/meshes)
+expect("${out}" "best: box-80x60x40 ")
+expect("${err}" "box-80x60x40.ply: 12 triangles: 20800 points sampled area-uniformly at 0.001")
+expect("${err}" "sphere-40.ply: 5120 triangles: ")
+run_tool("${RECOGNIZE}" 0 rec/clouds/sphere-25.ply rec/meshes)
+expect("${out}" "best: sphere-25 ")
+run_tool("${ICP}" 0 rec/clouds/cube-50.ply rec/meshes/cube-50.ply)
+expect("${err}" "cube-50.ply: 12 triangles: 1500[01] points sampled")
+expect("${out}" "\nstatus [a-z_]+\n")
+# The same meshes in millimetres: the warning with the fix, then a clear refusal (the surface
+# would need billions of points at 1 mm spacing in metres), never a crash or a silent answer.
+run_tool("${RECOGNIZE}" 1 --scale 1000 rec/clouds/box-80x60x40.ply rec/meshes)
+expect("${err}" "look like millimetres")
+expect("${err}" "needs [0-9.e+]+ points, more than 4194304")
+run_tool("${RECOGNIZE}" 2 --mesh-spacing -1 rec/clouds/box-80x60x40.ply rec/meshes)
+expect("${err}" "--mesh-spacing")

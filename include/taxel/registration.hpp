@@ -5,5 +5,6 @@
 
 #include "taxel/registration/icp.hpp"
 #include "taxel/registration/kernels.hpp"
+#include "taxel/registration/model.hpp"
 #include "taxel/registration/object_library.hpp"
 #include "taxel/registration/target.hpp"

@@ -361,6 +361,11 @@ TEST_CASE("ContactCloud rejects bad configuration naming the field", "[fusion]")
   CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = 0}), Contains("association_radius"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = std::nan("")}),
                     Contains("association_radius"));
+  // A gate in millimetres: said, with the value in metres.
+  CHECK_THROWS_WITH(tf::ContactCloud<>({.association_radius = 4.0}),
+                    Contains("association_radius = 4.000000 m looks like millimetres") &&
+                        Contains("4.000000 mm = 0.004000"));
+  CHECK_NOTHROW(tf::ContactCloud<>({.association_radius = 1.0}));
   CHECK_THROWS_WITH(KalmanCloud({.fusion = {.process_noise = -1}}), Contains("process_noise"));
   CHECK_THROWS_WITH(KalmanCloud({.fusion = {.gate_chi2 = 0.0}}), Contains("gate_chi2"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.kalman = {.process_noise = -1}}}),

@@ -4,6 +4,7 @@
 #include <random>
 #include <taxel/index/brute_force.hpp>
 #include <taxel/index/uniform_grid.hpp>
+#include <taxel/io/ply.hpp>
 #include <taxel/registration.hpp>
 #include <taxel/sim/sampling.hpp>
 #include <vector>
@@ -541,4 +542,63 @@ TEST_CASE("Target sizes its closest-point field to the model, never failing on a
   CHECK(big.has_field());
   CHECK_THROWS_WITH(Target<double>(mm, TargetConfig{.field_cell = 1e-3, .field_max_cells = 0}),
                     Contains("field_max_cells"));
+}
+
+TEST_CASE("Meshes of uneven vertex density are recognised by their surface, not their vertices",
+          "[registration][recognition][mesh]") {
+  // A 12-triangle box (8 vertices), a cylinder of 514 vertices and an icosphere of 2 562: as
+  // vertex clouds the sphere is dense everywhere and the box only at its corners. Each model
+  // file holds the mesh (PLY: vertices and faces), read back as a user's would be.
+  const sim::Box box(Vec3d(0.04, 0.03, 0.02));
+  const sim::Cylinder cyl(0.03, 0.05);
+  const sim::Sphere sphere(0.04);
+  const std::vector<std::pair<std::string, sim::TriangleMesh>> meshes{
+      {"box", sim::box_mesh(box)},
+      {"cylinder", sim::cylinder_mesh(cyl, 256)},
+      {"sphere", sim::icosphere(sphere.radius, 4)}};
+  ObjectLibrary<double> by_surface;
+  for (const auto& [name, mesh] : meshes) {
+    PointCloud<double> vertices;
+    vertices.points = mesh.vertices();
+    const std::string bytes =
+        io::encode_ply(vertices, io::PlyFormat::binary_little_endian, mesh.triangles());
+    const ModelCloud m = model_cloud(io::parse_ply(bytes, name + ".ply"));
+    CHECK(m.from_surface);
+    CHECK(m.triangles == mesh.triangles().size());
+    CHECK(m.cloud.size() ==
+          static_cast<std::size_t>(std::ceil(sim::surface_area(mesh) / (m.spacing * m.spacing))));
+    CHECK_THAT(m.describe(), Catch::Matchers::Contains("points sampled area-uniformly"));
+    by_surface.add(name, m.cloud);
+  }
+  // Partial, noisy, posed touches of the true shapes.
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  const auto touch = [&](const auto& shape, std::uint64_t seed) {
+    Eigen::Quaterniond q(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)));
+    q.normalize();
+    Isometry3d t = Isometry3d::Identity();
+    t.linear() = q.toRotationMatrix();
+    t.translation() = Vec3d(u(rng), u(rng), u(rng));
+    return transformed(sim::tactile_patches(shape, sim::PatchConfig{}, seed), t);
+  };
+  for (int trial = 0; trial < 3; ++trial) {
+    const auto seed = static_cast<std::uint64_t>(40 + trial);
+    CHECK(by_surface.recognize(touch(box, seed)).best == "box");
+    CHECK(by_surface.recognize(touch(cyl, seed)).best == "cylinder");
+    CHECK(by_surface.recognize(touch(sphere, seed)).best == "sphere");
+  }
+  // Spacing 0 keeps the vertices; a face naming a missing vertex and a surface of zero area are
+  // refused; faces of zero area are skipped and counted.
+  io::PlyData flat;
+  flat.cloud.points = {Vec3d::Zero(), Vec3d::UnitX(), Vec3d::UnitY(), Vec3d::UnitX()};
+  flat.triangles = {{0, 1, 2}, {0, 1, 3}};
+  const ModelCloud kept = model_cloud(flat, {.spacing = 0.0});
+  CHECK((!kept.from_surface && kept.cloud.size() == 4 && kept.describe() == "4 vertices"));
+  const ModelCloud skipped = model_cloud(flat, {.spacing = 0.1});
+  CHECK((skipped.from_surface && skipped.triangles == 1 && skipped.degenerate == 1));
+  CHECK(skipped.cloud.size() == 50);  // 0.5 m^2 / 0.01 m^2
+  flat.triangles = {{0, 1, 3}};
+  CHECK_THROWS_WITH(model_cloud(flat), Catch::Matchers::Contains("every face has zero area"));
+  flat.triangles = {{0, 1, 7}};
+  CHECK_THROWS_WITH(model_cloud(flat), Catch::Matchers::Contains("names vertex 7 of 4"));
 }

@@ -2,6 +2,9 @@
 // Tests of taxel::sim shapes (against closed forms and brute-force surface samples) and of the
 // sliding exploration stream.
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+#include <numbers>
 #include <random>
 #include <taxel/sim.hpp>
 
@@ -249,4 +252,117 @@ TEST_CASE(
       taxel::sim::TriangleMesh({taxel::Vec3d::Zero(), taxel::Vec3d::UnitX(), taxel::Vec3d::UnitX()},
                                {{0, 1, 2}}),
       Catch::Matchers::Contains("no area"));
+}
+
+namespace {
+
+// The closest point over every triangle by brute force: each triangle is a mesh of its own
+// (where the hierarchy has one leaf), the lowest index winning ties, as documented.
+struct BruteHit {
+  taxel::Vec3d point;
+  double d2 = std::numeric_limits<double>::infinity();
+  std::size_t face = 0;
+};
+BruteHit brute_closest(const std::vector<taxel::sim::TriangleMesh>& single, const taxel::Vec3d& p) {
+  BruteHit best;
+  for (std::size_t f = 0; f < single.size(); ++f) {
+    const taxel::Vec3d c = single[f].closest_point(p);
+    const double d2 = (p - c).squaredNorm();
+    if (d2 < best.d2) best = {c, d2, f};
+  }
+  return best;
+}
+std::vector<taxel::sim::TriangleMesh> one_mesh_per_triangle(const taxel::sim::TriangleMesh& m) {
+  std::vector<taxel::sim::TriangleMesh> out;
+  for (const auto& t : m.triangles()) {
+    out.emplace_back(
+        std::vector<taxel::Vec3d>{m.vertices()[t[0]], m.vertices()[t[1]], m.vertices()[t[2]]},
+        std::vector<taxel::sim::TriangleMesh::Triangle>{{0, 1, 2}});
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("TriangleMesh's hierarchy finds the same closest point as a scan of every triangle",
+          "[sim][mesh]") {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> jitter(0.0, 0.002);
+  // An icosphere with its vertices moved about (uneven triangles), a cylinder with long thin
+  // side facets and fans on the caps, and a box of twelve triangles.
+  taxel::sim::TriangleMesh ico = taxel::sim::icosphere(0.03, 3);
+  std::vector<taxel::Vec3d> moved = ico.vertices();
+  for (auto& v : moved) v += taxel::Vec3d(jitter(rng), jitter(rng), jitter(rng));
+  const std::vector<taxel::sim::TriangleMesh> meshes{
+      taxel::sim::TriangleMesh(moved, ico.triangles()),
+      taxel::sim::cylinder_mesh(taxel::sim::Cylinder(0.02, 0.05), 48),
+      taxel::sim::box_mesh(taxel::sim::Box(taxel::Vec3d(0.04, 0.01, 0.02)))};
+  std::uniform_real_distribution<double> u(-0.08, 0.08);
+  for (const auto& mesh : meshes) {
+    CAPTURE(mesh.triangles().size());
+    CHECK(mesh.hierarchy_nodes() > 0);
+    const auto single = one_mesh_per_triangle(mesh);
+    std::vector<taxel::Vec3d> queries;
+    for (int i = 0; i < 600; ++i) queries.emplace_back(u(rng), u(rng), u(rng));
+    for (int i = 0; i < 100; ++i) queries.push_back(taxel::Vec3d(u(rng), u(rng), u(rng)) * 100.0);
+    for (const auto& v : mesh.vertices()) queries.push_back(v);  // ties between faces
+    for (const auto& q : queries) {
+      const BruteHit b = brute_closest(single, q);
+      const taxel::Vec3d c = mesh.closest_point(q);
+      CAPTURE(q.transpose());
+      REQUIRE((q - c).squaredNorm() == b.d2);
+      CHECK(c == b.point);
+    }
+  }
+}
+
+TEST_CASE("box_mesh is the box, and cylinder_mesh is within its chord error of the cylinder",
+          "[sim][mesh]") {
+  const taxel::sim::Box box(taxel::Vec3d(0.04, 0.03, 0.02));
+  const taxel::sim::TriangleMesh bm = taxel::sim::box_mesh(box);
+  CHECK(bm.triangles().size() == 12);
+  CHECK(taxel::sim::surface_area(bm) == Approx(taxel::sim::surface_area(box)).epsilon(1e-12));
+  const taxel::sim::Cylinder cyl(0.03, 0.05);
+  const int n = 64;
+  const taxel::sim::TriangleMesh cm = taxel::sim::cylinder_mesh(cyl, n);
+  const double chord = cyl.radius * (1.0 - std::cos(std::numbers::pi / n));
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  double worst = 0.0;
+  for (int i = 0; i < 2000; ++i) {
+    const taxel::Vec3d q(u(rng), u(rng), u(rng));
+    CHECK(bm.signed_distance(q) == Approx(box.signed_distance(q)).margin(1e-12));
+    worst = std::max(worst, std::abs(cm.signed_distance(q) - cyl.signed_distance(q)));
+  }
+  CHECK(worst <= chord + 1e-12);
+  CHECK(worst > 0.2 * chord);  // the facets are really not the cylinder
+  CHECK_THROWS_WITH(taxel::sim::cylinder_mesh(cyl, 2), Catch::Matchers::Contains("segments"));
+}
+
+TEST_CASE("sample_surface_spacing: one point per spacing^2, area-uniform over uneven triangles",
+          "[sim][mesh]") {
+  const taxel::sim::Box box(taxel::Vec3d(0.04, 0.03, 0.02));
+  const double area = taxel::sim::surface_area(box);  // 0.0208 m^2
+  const auto cloud = taxel::sim::sample_surface_spacing(taxel::sim::box_mesh(box), 1e-3);
+  CHECK(cloud.size() == static_cast<std::size_t>(std::ceil(area / 1e-6)));
+  // Points per face (by their normal) against the face's share of the area: each within five
+  // binomial standard deviations.
+  const double n = static_cast<double>(cloud.size());
+  const double face_area[3] = {4 * 0.03 * 0.02, 4 * 0.04 * 0.02, 4 * 0.04 * 0.03};  // +-x, y, z
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {-1.0, 1.0}) {
+      double count = 0;
+      for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (cloud.normals[i][axis] == sign) ++count;
+      }
+      const double p = face_area[axis] / area;
+      CAPTURE(axis, sign, count, n * p);
+      CHECK(std::abs(count - n * p) < 5.0 * std::sqrt(n * p * (1 - p)));
+    }
+  }
+  CHECK_THROWS_WITH(
+      taxel::sim::sample_surface_spacing(box, 1e-6),
+      Catch::Matchers::Contains("more than 4194304") && Catch::Matchers::Contains("millimetres"));
+  CHECK_THROWS_WITH(taxel::sim::sample_surface_spacing(box, 0.0),
+                    Catch::Matchers::Contains("spacing must be"));
 }

@@ -273,6 +273,12 @@ class ContactCloud {
           "ContactCloud::Config::association_radius must be finite and > 0 [m], got " +
           std::to_string(r));
     }
+    if (r > Scalar(1)) {  // no tactile contact is gated at a metre: a length in millimetres
+      throw std::invalid_argument(
+          "ContactCloud::Config::association_radius = " + std::to_string(r) +
+          " m looks like millimetres; taxel uses metres (" + std::to_string(r) + " mm = " +
+          std::to_string(r / Scalar(1000)) + ")");
+    }
     return config;
   }
   // The index, from (radius, config), (config) or nothing, whichever it takes.

@@ -186,20 +186,14 @@ void sample_point(const Torus& t, Rng& rng, Vec3d& p, Vec3d& n) {
 }
 
 /// Surface area [m^2].
-inline double surface_area(const TriangleMesh& m) {
-  double a = 0.0;
-  for (std::size_t f = 0; f < m.triangles().size(); ++f) a += m.area(f);
-  return a;
-}
+inline double surface_area(const TriangleMesh& m) { return m.surface_area(); }
 
-/// Area-weighted uniform point on a mesh (a linear scan of the triangles: sample_surface on
-/// meshes costs O(triangles) per point).
+/// Area-weighted uniform point on a mesh (the triangle by binary search of the cumulative
+/// areas, then a uniform point in it), with the triangle's normal.
 template <class Rng>
 void sample_point(const TriangleMesh& m, Rng& rng, Vec3d& p, Vec3d& n) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  double pick = u(rng) * surface_area(m);
-  std::size_t f = 0;
-  while (f + 1 < m.triangles().size() && pick >= m.area(f)) pick -= m.area(f++);
+  const std::size_t f = m.face_at(u(rng));
   double s = u(rng), t = u(rng);
   if (s + t > 1.0) {
     s = 1.0 - s;
@@ -228,6 +222,29 @@ PointCloud<double> sample_surface(const Sh& shape, std::size_t count, std::uint6
   for (std::size_t i = 0; i < count; ++i)
     sample_point(shape, rng, cloud.points[i], cloud.normals[i]);
   return cloud;
+}
+
+/// About one point per `spacing`^2 of surface (ceil(area / spacing^2), at least 1), drawn as
+/// sample_surface draws them: the cloud a model file's surface stands for, whatever the density
+/// of its vertices. Throws std::invalid_argument for a spacing that is not finite and > 0, or one
+/// that would need more than `max_points` points (the message names the spacing that fits).
+template <SampleableShape Sh>
+PointCloud<double> sample_surface_spacing(const Sh& shape, double spacing, std::uint64_t seed = 1,
+                                          std::size_t max_points = std::size_t{1} << 22) {
+  if (!(spacing > 0.0) || !std::isfinite(spacing)) {
+    throw std::invalid_argument("sample_surface_spacing: spacing must be finite and > 0");
+  }
+  const double area = surface_area(shape);
+  const double count = std::max(1.0, std::ceil(area / (spacing * spacing)));
+  if (!(count <= static_cast<double>(max_points))) {
+    throw std::invalid_argument("sample_surface_spacing: a surface of " + std::to_string(area) +
+                                " m^2 at spacing " + std::to_string(spacing) + " m needs " +
+                                std::to_string(count) + " points, more than " +
+                                std::to_string(max_points) + "; a spacing of " +
+                                std::to_string(std::sqrt(area / static_cast<double>(max_points))) +
+                                " m or more fits (coordinates in millimetres? taxel uses metres)");
+  }
+  return sample_surface(shape, static_cast<std::size_t>(count), seed);
 }
 
 /// What a hand touching an object a few times gathers.

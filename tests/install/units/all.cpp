@@ -4,7 +4,7 @@
 #include "units.hpp"
 
 int unit_all() {
-  // The same calls as other units, from a unit that includes everything.
+  // The same calls as other units make: their instantiations must merge at link time.
   const taxel::sim::Sphere s(0.04);
   taxel::learn::FeatureMatrix x(4, 1);
   x << 0, 1, 5, 6;

@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include <taxel/fusion.hpp>
-#include <taxel/index/voxel_hash.hpp>
+#include <taxel/taxel.hpp>
 
 #include "units.hpp"
 

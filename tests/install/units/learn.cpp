@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-#include <taxel/learn.hpp>
 #include <vector>
+
+#include <taxel/taxel.hpp>
 
 #include "units.hpp"
 

@@ -5,8 +5,6 @@
 #include "units.hpp"
 
 int main() {
-  // This unit includes everything too, so every inline function and template instantiated
-  // in two units at once must merge at link time.
   const int failed = unit_fusion() + unit_index() + unit_registration() + unit_image() +
                      unit_learn() + unit_io() + unit_sim() + unit_sensor() + unit_all();
   std::printf("taxel %s, ten translation units: %d failed checks\n", TAXEL_VERSION_STRING, failed);

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include <Eigen/Geometry>
 #include <cmath>
-#include <taxel/registration.hpp>
 #include <vector>
+
+#include <taxel/taxel.hpp>
 
 #include "units.hpp"
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include <taxel/sensor.hpp>
+#include <taxel/taxel.hpp>
 
 #include "units.hpp"
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include <cmath>
-#include <taxel/sim.hpp>
+#include <taxel/taxel.hpp>
 
 #include "units.hpp"
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Ten translation units of one consumer program, each including a different part of the
-// installed taxel (two the whole library) and calling into it. Linking them together checks
+// Ten translation units of one consumer program, each including the whole of the
+// installed taxel and calling a different part of it. Linking them together checks
 // that every header is safe to include in many files of one program (no duplicate symbols);
 // each returns the number of its checks that failed.
 #pragma once
