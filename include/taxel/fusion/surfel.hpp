@@ -108,7 +108,8 @@ struct Surfel {
       return true;
     }
     const Vec3<S>& nc = *c.normal;
-    const Vec3<S> nm = s.normal_sum.normalized();
+    // Reciprocals taken once: divisions are a large part of this update's cost.
+    const Vec3<S> nm = s.normal_sum * (S(1) / std::sqrt(s.normal_sum.squaredNorm()));
     const S cos_c = nc.dot(nm);
     if (!(cos_c >= cos_max_)) return kalman_.fuse(s.kalman, c, n);
     // Turn the covariance onto the mean normal: Q = I + [v]x + [v]x^2 / (1 + c), v = nc x nm,
@@ -137,7 +138,8 @@ struct Surfel {
     // datum but an edge or an outlier, and would dominate the fit.
     const S nz = nc.dot(s.n0);
     if (!(nz >= cos_max_)) return true;
-    const S sx = s.t1.dot(nc) / nz, sy = t2.dot(nc) / nz;
+    const S inv_nz = S(1) / nz;
+    const S sx = s.t1.dot(nc) * inv_nz, sy = t2.dot(nc) * inv_nz;
     // Weighted like the Kalman average along the normal: by the contact's information there.
     const S w = S(1) / nm.dot(turned.covariance * nm);
     s.normal_sum += nc;

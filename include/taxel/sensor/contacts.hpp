@@ -168,7 +168,8 @@ class ContactExtractor {
     const double vn = var_along + sp2 + lever2 * st2 / 3.0 + q2() * slope_var;
     Contact<double> c;
     c.position = T * Vec3d(x, y, -depth);
-    const Vec3d n = (T.linear() * n_pad).normalized();
+    Vec3d n = T.linear() * n_pad;  // unit already when T's rotation is orthonormal; made sure
+    n *= 1.0 / std::sqrt(n.squaredNorm());
     c.covariance = Mat3d::Identity() * vt + (vn - vt) * (n * n.transpose());
     c.normal = n;
     c.pressure = pressure;
@@ -183,6 +184,7 @@ class ContactExtractor {
     const double p = g.pitch;
     const double vd = depth_variance();
     const double fb2 = options_.fallback_normal_sigma * options_.fallback_normal_sigma;
+    const double inv_p = 1.0 / p, inv_p2 = inv_p * inv_p;
     std::size_t added = 0;
     for (int r = 0; r < g.rows; ++r) {
       for (int c = 0; c < g.cols; ++c) {
@@ -211,28 +213,34 @@ class ContactExtractor {
               syd += dr * d;
             }
           }
-          const double cxx = sxx - sx * sx / n, cyy = syy - sy * sy / n, cxy = sxy - sx * sy / n;
-          const double cxd = sxd - sx * sd / n, cyd = syd - sy * sd / n;
+          // One division each for 1/n and 1/det: the per-tactel cost is dominated by them.
+          const double inv_n = 1.0 / n;
+          const double cxx = sxx - sx * sx * inv_n, cyy = syy - sy * sy * inv_n,
+                       cxy = sxy - sx * sy * inv_n;
+          const double cxd = sxd - sx * sd * inv_n, cyd = syd - sy * sd * inv_n;
           const double det = cxx * cyy - cxy * cxy;
           constexpr double kTiny = 1e-9;
           if (cxx > kTiny && cyy > kTiny && det > 0.1 * cxx * cyy) {
-            gx = (cyy * cxd - cxy * cyd) / det / p;
-            gy = (cxx * cyd - cxy * cxd) / det / p;
-            vgx = vd * cyy / det / (p * p);
-            vgy = vd * cxx / det / (p * p);
+            const double inv_det = 1.0 / det;
+            gx = (cyy * cxd - cxy * cyd) * inv_det * inv_p;
+            gy = (cxx * cyd - cxy * cxd) * inv_det * inv_p;
+            vgx = vd * cyy * inv_det * inv_p2;
+            vgy = vd * cxx * inv_det * inv_p2;
           } else if (cxx > kTiny && std::abs(cxy) <= kTiny) {  // a row: x slope only
-            gx = cxd / cxx / p;
-            vgx = vd / cxx / (p * p);
+            gx = cxd / cxx * inv_p;
+            vgx = vd / cxx * inv_p2;
             vgy = fb2;
           } else if (cyy > kTiny && std::abs(cxy) <= kTiny) {  // a column: y slope only
-            gy = cyd / cyy / p;
-            vgy = vd / cyy / (p * p);
+            gy = cyd / cyy * inv_p;
+            vgy = vd / cyy * inv_p2;
             vgx = fb2;
           } else {
             vgx = vgy = fb2;
           }
         }
-        const Vec3d n_pad = -Vec3d(gx, gy, 1.0).normalized();
+        // The outward normal -(gx, gy, 1) / |(gx, gy, 1)|, with one division.
+        const double scale = -1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
+        const Vec3d n_pad(gx * scale, gy * scale, scale);
         const Vec3d at = g.tactel(r, c);
         const int k = counts(r, c);
         const double corr = bias_[static_cast<std::size_t>(k)];
