@@ -26,12 +26,17 @@ options:
 
 model_file is a LIBLINEAR text model (from taxel-train or LIBLINEAR's train, any classification
 solver). As LIBLINEAR does, features beyond the model's nr_feature are ignored. Prints
-"Accuracy = x% (correct/total)" against the labels of test_file.
+"Accuracy = x% (correct/total)" against the labels of test_file. -b (probability estimates)
+is refused: LIBLINEAR gives them only for logistic-regression models.
+
+Exit status: 0 on success, 1 for unreadable data or model (or an output that cannot be
+written), 2 for bad options.
 )usage";
 
-[[noreturn]] void fail(const std::string& why) {
+// Bad options exit 2, bad data 1.
+[[noreturn]] void fail(const std::string& why, int code = 1) {
   std::fprintf(stderr, "taxel-predict: %s\n", why.c_str());
-  std::exit(1);
+  std::exit(code);
 }
 
 }  // namespace
@@ -56,19 +61,23 @@ int main(int argc, char** argv) {
         std::uint64_t v = 0;
         const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
         if (r.ec != std::errc{} || r.ptr != t.data() + t.size() || v == 0) {
-          fail("--max-values expects a positive integer, got '" + std::string(t) + "'");
+          fail("--max-values expects a positive integer, got '" + std::string(t) + "'", 2);
         }
         read_opt.max_values = v;
+      } else if (a == "-b") {
+        fail(
+            "-b (probability estimates) is not available: LIBLINEAR gives them only for "
+            "logistic-regression models, and taxel's are SVMs",
+            2);
       } else if (a.size() > 1 && a[0] == '-') {
-        std::fprintf(stderr, "taxel-predict: unknown option %s\n%s", argv[i], kUsage);
-        return 1;
+        fail("unknown option '" + std::string(a) + "' (see --help)", 2);
       } else {
         files.emplace_back(a);
       }
     }
     if (files.size() != 3) {
       std::fputs(kUsage, stderr);
-      return 1;
+      return 2;
     }
     const tl::LinearSvm model = tl::LinearSvm::load(taxel::io::read_file(files[1]), files[1]);
     tl::Dataset test = taxel::io::read_libsvm(files[0], read_opt);

@@ -7,11 +7,13 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <taxel/io/ply.hpp>
 #include <taxel/registration.hpp>
+#include <utility>
 #include <vector>
 
 #include "cli.hpp"
@@ -27,7 +29,9 @@ Recognises the object a tactile cloud was taken from: every MODEL (a .ply file, 
 whose .ply files are all models; the name is the file name without .ply) is aligned to the
 cloud from 28 starts (4 principal-axes, 24 cube rotations) and scored by the truncated RMS
 distance of the cloud's points to it. Prints the ranking, best first, then the answer: the best
-model's name, or "unknown" when even it scores above --unknown. Distances in metres. A PLY
+model's name, or "unknown" when even it scores above --unknown; then the best model's pose
+T_model_cloud (which maps the cloud onto the model) as a 4x4 matrix, a translation and an
+axis-angle rotation. Distances in metres. A PLY
 with faces (a mesh) stands for its surface: points drawn uniformly over it by area, about one
 per --mesh-spacing squared, so a finely and a coarsely meshed model weigh alike; one line on
 standard error says so for each.
@@ -144,14 +148,29 @@ int main(int argc, char** argv) {
   }
   if (!r.ok()) die(inputs[0] + ": " + r.message, 1);
 
+  // T_model_cloud as translation [m] and axis-angle (unit axis, angle [rad]).
+  const auto axis_angle = [](const taxel::Isometry3d& t) {
+    const Eigen::AngleAxisd aa(t.linear());
+    return std::pair<taxel::Vec3d, double>(aa.angle() > 0.0 ? aa.axis() : taxel::Vec3d::UnitZ(),
+                                           aa.angle());
+  };
   if (json) {
     std::printf("{\"best\": \"%s\", \"unknown\": %s, \"margin\": %.9g, \"ranking\": [",
                 taxel_cli::json_escape(r.best).c_str(), r.unknown ? "true" : "false", r.margin);
     for (std::size_t k = 0; k < r.ranking.size(); ++k) {
       const auto& m = r.ranking[k];
-      std::printf("%s\n  {\"model\": \"%s\", \"score\": %.9g, \"rmse\": %.9g, \"fitness\": %.6f}",
-                  k ? "," : "", taxel_cli::json_escape(m.name).c_str(), m.score, m.rmse,
-                  m.inlier_fraction);
+      const auto [axis, angle] = axis_angle(m.transform);
+      const taxel::Vec3d t = m.transform.translation();
+      std::printf(
+          "%s\n  {\"model\": \"%s\", \"score\": %.9g, \"rmse\": %.9g, \"fitness\": %.6f, "
+          "\"translation\": [%.9g, %.9g, %.9g], \"axis\": [%.9g, %.9g, %.9g], "
+          "\"angle\": %.9g, \"transform\": [",
+          k ? "," : "", taxel_cli::json_escape(m.name).c_str(), m.score, m.rmse, m.inlier_fraction,
+          t.x(), t.y(), t.z(), axis.x(), axis.y(), axis.z(), angle);
+      for (int i = 0; i < 16; ++i) {
+        std::printf("%s%.17g", i ? ", " : "", m.transform.matrix()(i / 4, i % 4));
+      }
+      std::printf("]}");
     }
     std::printf("\n]}\n");
     return 0;
@@ -167,5 +186,17 @@ int main(int argc, char** argv) {
     }
   }
   std::printf("best: %s (margin %.3f mm)\n", r.best.c_str(), 1e3 * r.margin);
+  // The pose of the best-scoring model (also when the answer is unknown): T_model_cloud maps
+  // the cloud's points onto the model.
+  const auto& top = r.ranking.front();
+  const auto [axis, angle] = axis_angle(top.transform);
+  const taxel::Vec3d t = top.transform.translation();
+  std::printf("pose of %s (T_model_cloud):\n", top.name.c_str());
+  for (int row = 0; row < 4; ++row) {
+    std::printf("%.9g %.9g %.9g %.9g\n", top.transform(row, 0), top.transform(row, 1),
+                top.transform(row, 2), top.transform(row, 3));
+  }
+  std::printf("translation %.9g %.9g %.9g\naxis %.9g %.9g %.9g\nangle %.9g rad (%.3f deg)\n", t.x(),
+              t.y(), t.z(), axis.x(), axis.y(), axis.z(), angle, angle * 180.0 / std::numbers::pi);
   return 0;
 }

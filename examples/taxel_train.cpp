@@ -4,8 +4,10 @@
 #include <unistd.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <taxel/io.hpp>
@@ -23,6 +25,9 @@ options:
 	 1 -- L2-regularized L2-loss support vector classification (dual)
 	 3 -- L2-regularized L1-loss support vector classification (dual)
 -c cost : set the parameter C (default 1)
+-wi weight : weight of class i: its samples cost weight * C (default 1; e.g. -w1 5 -w-1 0.5)
+-C : find the C with the best cross-validation accuracy (C = 2^k from 2^-10 up to 2^10, n
+	 folds of -v or 5) and print "Best C = ... CV accuracy = ...%"; no model is written
 -e epsilon : set tolerance of termination criterion (default 0.1)
 	 |f'(alpha)|_max - |f'(alpha)|_min <= eps, the projected gradient spread
 -B bias : if bias >= 0, instance x becomes [x; bias]; if < 0, no bias term added (default -1)
@@ -35,21 +40,27 @@ options:
 -h, --help : show this help
 --version : show the version
 
+Exit status: 0 on success, 1 for unreadable or unusable data (and a model file that cannot be
+written), 2 for bad options. -b (probability estimates) is refused: LIBLINEAR gives them only
+for logistic regression, and taxel-train's solvers are SVMs.
+
 The model file is LIBLINEAR's text format (default: <training_set_file basename>.model in the
 current directory); LIBLINEAR's predict and taxel-predict both read it.
 )usage";
 
-[[noreturn]] void fail(const std::string& why) {
+// Bad options exit 2, bad data 1.
+[[noreturn]] void fail(const std::string& why, int code = 1) {
   std::fprintf(stderr, "taxel-train: %s\n", why.c_str());
-  std::exit(1);
+  std::exit(code);
 }
+[[noreturn]] void usage_error(const std::string& why) { fail(why, 2); }
 
 double number(std::string_view opt, const char* text) {
   double v = 0.0;
   const std::string_view t(text);
   const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
   if (r.ec != std::errc{} || r.ptr != t.data() + t.size()) {
-    fail("option " + std::string(opt) + " expects a number, got '" + std::string(t) + "'");
+    usage_error("option " + std::string(opt) + " expects a number, got '" + std::string(t) + "'");
   }
   return v;
 }
@@ -69,13 +80,14 @@ int main(int argc, char** argv) {
     int folds = 0;
     bool quiet = false;
     bool grouped = false;
+    bool search_c = false;
     std::string data_file;
     std::string model_file;
     taxel::io::LibsvmReadOptions read_opt;
     for (int i = 1; i < argc; ++i) {
       const std::string_view a = argv[i];
       const auto value = [&]() -> const char* {
-        if (i + 1 >= argc) fail("option " + std::string(a) + " needs a value");
+        if (i + 1 >= argc) usage_error("option " + std::string(a) + " needs a value");
         return argv[++i];
       };
       if (a == "-h" || a == "--help") {
@@ -84,8 +96,8 @@ int main(int argc, char** argv) {
       } else if (a == "-s") {
         const double s = number(a, value());
         if (s != 1.0 && s != 3.0)
-          fail("-s " + std::to_string(static_cast<int>(s)) +
-               " is not supported: taxel-train has solvers 1 (L2-loss) and 3 (L1-loss)");
+          usage_error("-s " + std::to_string(static_cast<int>(s)) +
+                      " is not supported: taxel-train has solvers 1 (L2-loss) and 3 (L1-loss)");
         cfg.loss = s == 1.0 ? tl::SvmLoss::l2 : tl::SvmLoss::l1;
       } else if (a == "-c") {
         cfg.C = number(a, value());
@@ -96,7 +108,7 @@ int main(int argc, char** argv) {
       } else if (a == "-v") {
         const double v = number(a, value());
         if (v < 2 || v != static_cast<int>(v))
-          fail("n-fold cross validation: n must be an integer >= 2");
+          usage_error("n-fold cross validation: n must be an integer >= 2");
         folds = static_cast<int>(v);
       } else if (a == "-q") {
         quiet = true;
@@ -106,27 +118,72 @@ int main(int argc, char** argv) {
         cfg.max_iterations = static_cast<int>(number(a, value()));
       } else if (a == "--max-values") {
         const double v = number(a, value());
-        if (!(v >= 1.0 && v <= 1e18)) fail("--max-values must be in [1, 1e18]");
+        if (!(v >= 1.0 && v <= 1e18)) usage_error("--max-values must be in [1, 1e18]");
         read_opt.max_values = static_cast<std::uint64_t>(v);
       } else if (a == "--grouped") {
         grouped = true;
+      } else if (a == "-C") {
+        search_c = true;
+      } else if (a == "-b") {
+        usage_error(
+            "-b (probability estimates) is not available: LIBLINEAR gives them only for "
+            "logistic regression (-s 0, 6, 7), and taxel-train's solvers are SVMs (-s 1, 3)");
+      } else if (a.size() > 2 && a.substr(0, 2) == "-w") {
+        int label = 0;
+        const std::string_view l = a.substr(2);
+        const auto r = std::from_chars(l.data(), l.data() + l.size(), label);
+        if (r.ec != std::errc{} || r.ptr != l.data() + l.size()) {
+          usage_error("-w takes a class label glued to it (-w1 5, -w-1 0.5), got '" +
+                      std::string(a) + "'");
+        }
+        cfg.class_weights.emplace_back(label, number(a, value()));
       } else if (a.size() > 1 && a[0] == '-') {
-        std::fprintf(stderr, "taxel-train: unknown option %s\n%s", argv[i], kUsage);
-        return 1;
+        usage_error("unknown option '" + std::string(a) + "' (see --help)");
       } else if (data_file.empty()) {
         data_file = a;
       } else if (model_file.empty()) {
         model_file = a;
       } else {
-        fail("too many arguments (see --help)");
+        usage_error("too many arguments (see --help)");
       }
     }
     if (data_file.empty()) {
       std::fputs(kUsage, stderr);
-      return 1;
+      return 2;
     }
-    const tl::LinearSvm prototype(cfg);  // validates the options
+    std::optional<tl::LinearSvm> checked;
+    try {
+      checked.emplace(cfg);  // validates the options
+    } catch (const std::invalid_argument& e) {
+      usage_error(e.what());
+    }
+    const tl::LinearSvm& prototype = *checked;
     const tl::Dataset data = taxel::io::read_libsvm(data_file, read_opt);
+
+    if (search_c) {
+      // LIBLINEAR's -C searches upwards from a small C with warm starts, for its primal
+      // solvers only; here every C of the grid is cross-validated from scratch.
+      tl::CvOptions opt;
+      opt.folds = folds > 0 ? folds : 5;
+      opt.seed = cfg.seed;
+      opt.grouped = grouped;
+      double best_c = 0.0, best_accuracy = -1.0;
+      for (int e = -10; e <= 10; ++e) {
+        tl::LinearSvmConfig c = cfg;
+        c.C = std::ldexp(1.0, e);
+        const tl::CvReport r = tl::cross_validate(tl::LinearSvm(c), data.view(), opt);
+        if (r.status == taxel::Status::invalid_input || r.status == taxel::Status::degenerate) {
+          fail(data_file + ": " + r.message);
+        }
+        if (!quiet) std::printf("log2c= %3d\trate= %g\n", e, 100.0 * r.accuracy);
+        if (r.accuracy > best_accuracy) {
+          best_accuracy = r.accuracy;
+          best_c = c.C;
+        }
+      }
+      std::printf("Best C = %g  CV accuracy = %g%%\n", best_c, 100.0 * best_accuracy);
+      return 0;
+    }
 
     if (folds > 0) {
       tl::CvOptions opt;

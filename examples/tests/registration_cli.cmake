@@ -118,3 +118,21 @@ expect("${err}" "look like millimetres")
 expect("${err}" "needs [0-9.e+]+ points, more than 4194304")
 run_tool("${RECOGNIZE}" 2 --mesh-spacing -1 rec/clouds/box-80x60x40.ply rec/meshes)
 expect("${err}" "--mesh-spacing")
+
+# The recognised pose: T_model_cloud as 4x4, translation and axis-angle. Fed to taxel-icp as
+# its initial transform, it already maps the cloud onto the model (one iteration, low RMSE).
+run_tool("${RECOGNIZE}" 0 rec/clouds/box-80x60x40.ply rec/models)
+expect("${out}" "best: box-80x60x40 ")
+string(REGEX MATCH "pose of box-80x60x40 \\(T_model_cloud\\):\n([^\n]+)\n([^\n]+)\n([^\n]+)\n([^\n]+)\n"
+       m "${out}")
+if(NOT m)
+  message(FATAL_ERROR "no pose in:\n${out}")
+endif()
+set(pose "${CMAKE_MATCH_1} ${CMAKE_MATCH_2} ${CMAKE_MATCH_3} ${CMAKE_MATCH_4}")
+expect("${out}" "\ntranslation [-0-9.e]+ [-0-9.e]+ [-0-9.e]+\naxis [-0-9.e]+ [-0-9.e]+ [-0-9.e]+\nangle [0-9.e]+ rad")
+run_tool("${ICP}" 0 --init "${pose}" --max-iterations 1 rec/clouds/box-80x60x40.ply
+         rec/models/box-80x60x40.ply)
+expect("${out}" "\nrmse 0\\.00[01][0-9]*\n")
+run_tool("${RECOGNIZE}" 0 --format json --starts 4 rec/clouds/box-80x60x40.ply rec/models)
+expect("${out}" "\"translation\": \\[[-0-9.e]+, [-0-9.e]+, [-0-9.e]+\\], \"axis\": \\[")
+expect("${out}" "\"transform\": \\[[-0-9.e]+(, [-0-9.e]+)+\\]")

@@ -64,65 +64,83 @@ TEST_CASE("LinearSvm agrees with LIBLINEAR on converged weights and predictions"
   for (const auto& [name, d] : data_sets()) {
     for (const SvmLoss loss : {SvmLoss::l2, SvmLoss::l1}) {
       for (const double bias : {-1.0, 1.0}) {
-        // Dual CD converges slowly at large C and LIBLINEAR stops at 1000 iterations.
-        const double C = name == "heart_scale" && loss == SvmLoss::l2 ? 1.0 : 0.05;
-        INFO(name << ", loss " << (loss == SvmLoss::l2 ? "L2" : "L1") << ", bias " << bias);
-        LinearSvmConfig cfg{.loss = loss, .C = C, .eps = 1e-9, .bias = bias};
-        LinearSvm ours(cfg);
-        REQUIRE(ours.fit(d.view()).ok());
-
-        SparseRows<feature_node> rows(d, bias);
-        problem prob{static_cast<int>(d.rows()), static_cast<int>(d.dims()) + (bias >= 0 ? 1 : 0),
-                     rows.y.data(), rows.ptr.data(), bias};
-        parameter par{};
-        par.solver_type = loss == SvmLoss::l2 ? L2R_L2LOSS_SVC_DUAL : L2R_L1LOSS_SVC_DUAL;
-        par.eps = 1e-9;
-        par.C = C;
-        model* theirs = train(&prob, &par);
-        REQUIRE(theirs != nullptr);
-        REQUIRE(get_nr_class(theirs) == static_cast<int>(ours.classes().size()));
-        for (int c = 0; c < get_nr_class(theirs); ++c)
-          CHECK(theirs->label[c] == ours.classes()[static_cast<std::size_t>(c)]);
-        const int nr_w = static_cast<int>(ours.weights().rows());
-        double max_diff = 0.0;
-        for (int j = 0; j < static_cast<int>(d.dims()); ++j) {
-          for (int k = 0; k < nr_w; ++k) {
-            max_diff =
-                std::max(max_diff, std::fabs(theirs->w[j * nr_w + k] - ours.weights()(k, j)));
+        for (const bool weighted : {false, true}) {
+          // Dual CD converges slowly at large C and LIBLINEAR stops at 1000 iterations.
+          const double C = weighted                                       ? 0.02
+                           : name == "heart_scale" && loss == SvmLoss::l2 ? 1.0
+                                                                          : 0.05;
+          INFO(name << ", loss " << (loss == SvmLoss::l2 ? "L2" : "L1") << ", bias " << bias
+                    << (weighted ? ", class weights 3 and 0.5" : ""));
+          LinearSvmConfig cfg{.loss = loss, .C = C, .eps = 1e-9, .bias = bias};
+          // -w: the first two labels in the data, weighted 3 and 0.5 (LIBLINEAR's weighted C).
+          std::vector<int> weight_label;
+          std::vector<double> weight_value;
+          if (weighted) {
+            const std::vector<int> order = class_order(d.y);
+            weight_label = {order[0], order[1]};
+            weight_value = {3.0, 0.5};
+            cfg.class_weights = {{order[0], 3.0}, {order[1], 0.5}};
           }
-        }
-        if (bias >= 0) {
-          for (int k = 0; k < nr_w; ++k) {
-            max_diff = std::max(max_diff,
-                                std::fabs(theirs->w[d.dims() * nr_w + k] - ours.bias_weights()(k)));
-          }
-        }
-        CHECK(max_diff < 1e-6);
-        int disagree = 0;
-        for (Eigen::Index i = 0; i < d.rows(); ++i) {
-          const auto a = static_cast<int>(::predict(theirs, rows.ptr[static_cast<std::size_t>(i)]));
-          disagree += a != ours.predict(d.x.row(i).transpose()) ? 1 : 0;
-        }
-        CHECK(disagree == 0);
+          LinearSvm ours(cfg);
+          REQUIRE(ours.fit(d.view()).ok());
 
-        // Model files cross over both ways.
-        const auto dir = std::filesystem::temp_directory_path();
-        const std::string ours_file = (dir / "taxel_oracle_ours.model").string();
-        const std::string theirs_file = (dir / "taxel_oracle_theirs.model").string();
-        taxel::io::write_file(ours_file, ours.save());
-        model* loaded = load_model(ours_file.c_str());
-        REQUIRE(loaded != nullptr);
-        REQUIRE(save_model(theirs_file.c_str(), theirs) == 0);
-        const LinearSvm back = LinearSvm::load(taxel::io::read_file(theirs_file), theirs_file);
-        for (Eigen::Index i = 0; i < d.rows(); ++i) {
-          const auto* xi = rows.ptr[static_cast<std::size_t>(i)];
-          CHECK(static_cast<int>(::predict(loaded, xi)) == ours.predict(d.x.row(i).transpose()));
-          CHECK(back.predict(d.x.row(i).transpose()) == static_cast<int>(::predict(theirs, xi)));
+          SparseRows<feature_node> rows(d, bias);
+          problem prob{static_cast<int>(d.rows()), static_cast<int>(d.dims()) + (bias >= 0 ? 1 : 0),
+                       rows.y.data(), rows.ptr.data(), bias};
+          parameter par{};
+          par.solver_type = loss == SvmLoss::l2 ? L2R_L2LOSS_SVC_DUAL : L2R_L1LOSS_SVC_DUAL;
+          par.eps = 1e-9;
+          par.C = C;
+          par.nr_weight = static_cast<int>(weight_label.size());
+          par.weight_label = weight_label.data();
+          par.weight = weight_value.data();
+          model* theirs = train(&prob, &par);
+          REQUIRE(theirs != nullptr);
+          REQUIRE(get_nr_class(theirs) == static_cast<int>(ours.classes().size()));
+          for (int c = 0; c < get_nr_class(theirs); ++c)
+            CHECK(theirs->label[c] == ours.classes()[static_cast<std::size_t>(c)]);
+          const int nr_w = static_cast<int>(ours.weights().rows());
+          double max_diff = 0.0;
+          for (int j = 0; j < static_cast<int>(d.dims()); ++j) {
+            for (int k = 0; k < nr_w; ++k) {
+              max_diff =
+                  std::max(max_diff, std::fabs(theirs->w[j * nr_w + k] - ours.weights()(k, j)));
+            }
+          }
+          if (bias >= 0) {
+            for (int k = 0; k < nr_w; ++k) {
+              max_diff = std::max(
+                  max_diff, std::fabs(theirs->w[d.dims() * nr_w + k] - ours.bias_weights()(k)));
+            }
+          }
+          CHECK(max_diff < 1e-6);
+          int disagree = 0;
+          for (Eigen::Index i = 0; i < d.rows(); ++i) {
+            const auto a =
+                static_cast<int>(::predict(theirs, rows.ptr[static_cast<std::size_t>(i)]));
+            disagree += a != ours.predict(d.x.row(i).transpose()) ? 1 : 0;
+          }
+          CHECK(disagree == 0);
+
+          // Model files cross over both ways.
+          const auto dir = std::filesystem::temp_directory_path();
+          const std::string ours_file = (dir / "taxel_oracle_ours.model").string();
+          const std::string theirs_file = (dir / "taxel_oracle_theirs.model").string();
+          taxel::io::write_file(ours_file, ours.save());
+          model* loaded = load_model(ours_file.c_str());
+          REQUIRE(loaded != nullptr);
+          REQUIRE(save_model(theirs_file.c_str(), theirs) == 0);
+          const LinearSvm back = LinearSvm::load(taxel::io::read_file(theirs_file), theirs_file);
+          for (Eigen::Index i = 0; i < d.rows(); ++i) {
+            const auto* xi = rows.ptr[static_cast<std::size_t>(i)];
+            CHECK(static_cast<int>(::predict(loaded, xi)) == ours.predict(d.x.row(i).transpose()));
+            CHECK(back.predict(d.x.row(i).transpose()) == static_cast<int>(::predict(theirs, xi)));
+          }
+          free_and_destroy_model(&loaded);
+          free_and_destroy_model(&theirs);
+          std::filesystem::remove(ours_file);
+          std::filesystem::remove(theirs_file);
         }
-        free_and_destroy_model(&loaded);
-        free_and_destroy_model(&theirs);
-        std::filesystem::remove(ours_file);
-        std::filesystem::remove(theirs_file);
       }
     }
   }

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "taxel/core/deferred.hpp"
@@ -40,6 +41,10 @@ struct LinearSvmConfig {
   bool shrinking = true;          ///< skip variables at a bound whose gradient points outward
   std::uint64_t seed = 1;         ///< seed of the per-iteration random permutation
   bool record_objective = false;  ///< keep the dual objective after every outer iteration
+  /// -w<label> weight: the cost of a class is weight * C (LIBLINEAR's weighted C: in
+  /// one-vs-rest the class's own samples cost weight_k * C and the rest C; with two classes
+  /// each class costs its own weight * C). Classes not listed weigh 1. Weights > 0.
+  std::vector<std::pair<int, double>> class_weights{};
 };
 
 /// What training did, per binary problem (one per class in one-vs-rest, one for two classes).
@@ -67,6 +72,13 @@ class LinearSvm {
     if (!(cfg.eps > 0.0) || !std::isfinite(cfg.eps)) bad("eps", cfg.eps, "(0, inf)");
     if (!std::isfinite(cfg.bias)) bad("bias", cfg.bias, "(-inf, inf)");
     if (cfg.max_iterations < 1) bad("max_iterations", cfg.max_iterations, "[1, inf)");
+    for (const auto& [label, weight] : cfg.class_weights) {
+      if (!(weight > 0.0) || !std::isfinite(weight) || !std::isfinite(weight * cfg.C)) {
+        throw std::invalid_argument("LinearSvmConfig: the weight of class " +
+                                    std::to_string(label) + " = " + std::to_string(weight) +
+                                    " is outside the allowed range (0, inf)");
+      }
+    }
   }
 
   /// Trains on `d`. Returns `invalid_input` (keeping the previous model) for an empty set,
@@ -108,8 +120,10 @@ class LinearSvm {
       VectorXd wk = VectorXd::Zero(dims);
       double wbk = 0.0;
       std::vector<double> trace;
+      const double cp = cost_of(classes[static_cast<std::size_t>(k)]);
+      const double cn = nr_class == 2 ? cost_of(classes[1]) : cfg_.C;
       const Solve s =
-          solve(d.x, sign, qd_base, wk, wbk, rng, cfg_.record_objective ? &trace : nullptr);
+          solve(d.x, sign, qd_base, cp, cn, wk, wbk, rng, cfg_.record_objective ? &trace : nullptr);
       w.row(k) = wk.transpose();
       wb(k) = wbk;
       info.iterations.push_back(s.iterations);
@@ -337,27 +351,39 @@ class LinearSvm {
     return v;
   }
 
-  // Dual coordinate descent of LIBLINEAR's solve_l2r_l1l2_svc, on dense rows.
+  // The cost C of a class's samples: C times its weight.
+  [[nodiscard]] double cost_of(int label) const noexcept {
+    for (const auto& [l, weight] : cfg_.class_weights) {
+      if (l == label) return weight * cfg_.C;
+    }
+    return cfg_.C;
+  }
+
+  // Dual coordinate descent of LIBLINEAR's solve_l2r_l1l2_svc, on dense rows: cp is the cost of
+  // the samples with y = +1, cn of those with y = -1.
   template <class D = void>
   Solve solve(const Deferred<Eigen::Ref<const FeatureMatrix>, D>& x,
               const Deferred<std::vector<signed char>, D>& y,
-              const Deferred<Eigen::VectorXd, D>& qd_base, Eigen::VectorXd& w, double& wb,
-              std::mt19937_64& rng, std::vector<double>* trace) const {
+              const Deferred<Eigen::VectorXd, D>& qd_base, double cp, double cn, Eigen::VectorXd& w,
+              double& wb, std::mt19937_64& rng, std::vector<double>* trace) const {
     using VectorXd = Deferred<Eigen::VectorXd, D>;
     const auto n = static_cast<std::size_t>(x.rows());
     const Eigen::Index dims = x.cols();
     const double bias = cfg_.bias;
     const bool has_bias = bias >= 0.0;
-    const double diag = cfg_.loss == SvmLoss::l2 ? 0.5 / cfg_.C : 0.0;
-    const double upper =
-        cfg_.loss == SvmLoss::l2 ? std::numeric_limits<double>::infinity() : cfg_.C;
     constexpr double kInf = std::numeric_limits<double>::infinity();
+    const bool l2 = cfg_.loss == SvmLoss::l2;
+    // Indexed by (y + 1) / 2: the negative class first.
+    const double diag_of[2] = {l2 ? 0.5 / cn : 0.0, l2 ? 0.5 / cp : 0.0};
+    const double upper_of[2] = {l2 ? kInf : cn, l2 ? kInf : cp};
+    std::vector<double> diag_i(n);
+    for (std::size_t i = 0; i < n; ++i) diag_i[i] = diag_of[y[i] > 0 ? 1 : 0];
 
     std::vector<double> alpha(n, 0.0);
     std::vector<double> qd(n);
     std::vector<std::size_t> index(n);
     for (std::size_t i = 0; i < n; ++i) {
-      qd[i] = qd_base(static_cast<Eigen::Index>(i)) + diag;
+      qd[i] = qd_base(static_cast<Eigen::Index>(i)) + diag_i[i];
       index[i] = i;
     }
     std::size_t active = n;
@@ -376,6 +402,8 @@ class LinearSvm {
       for (std::size_t s = 0; s < active; ++s) {
         const std::size_t i = index[s];
         const double yi = y[i];
+        const double diag = diag_i[i];
+        const double upper = upper_of[yi > 0 ? 1 : 0];
         const Eigen::Map<const VectorXd> xi(base + static_cast<Eigen::Index>(i) * stride, dims);
         double g = xi.dot(w);
         if (has_bias) g += bias * wb;
@@ -411,7 +439,7 @@ class LinearSvm {
         }
       }
       ++iter;
-      if (trace != nullptr) trace->push_back(dual_objective(w, wb, alpha, diag));
+      if (trace != nullptr) trace->push_back(dual_objective(w, wb, alpha, diag_i));
       if (pg_max_new - pg_min_new <= cfg_.eps) {
         if (active == n) break;
         active = n;  // converged on the shrunk set: check all variables once more
@@ -426,7 +454,7 @@ class LinearSvm {
     }
     Solve s;
     s.iterations = iter;
-    s.objective = dual_objective(w, wb, alpha, diag);
+    s.objective = dual_objective(w, wb, alpha, diag_i);
     for (double a : alpha) s.support_vectors += a > 0.0 ? 1 : 0;
     return s;
   }
@@ -434,9 +462,10 @@ class LinearSvm {
   // 1/2 a'(Q + D)a - e'a = 1/2 (|w|^2 + sum a_i^2 D_ii) - sum a_i.
   template <class D = void>
   static double dual_objective(const Deferred<Eigen::VectorXd, D>& w, double wb,
-                               const Deferred<std::vector<double>, D>& alpha, double diag) {
+                               const Deferred<std::vector<double>, D>& alpha,
+                               const std::vector<double>& diag) {
     double v = w.squaredNorm() + wb * wb;
-    for (double a : alpha) v += a * (a * diag - 2.0);
+    for (std::size_t i = 0; i < alpha.size(); ++i) v += alpha[i] * (alpha[i] * diag[i] - 2.0);
     return 0.5 * v;
   }
 
