@@ -60,6 +60,9 @@ options:
   --min-observations N   keep only points with at least N contacts (default 1: all)
   --max-sigma S     keep only points whose largest standard deviation is at most S [m]
   --ascii           write ASCII PLY (default binary little-endian)
+  --strict          refuse a CONTACTS.csv with any bad row or unknown column (default: skip
+                    bad rows, counted as "skipped_rows" with the first one's reason on
+                    standard error, and ignore unknown columns, named once)
   --scale F         multiply the contacts' positions by F (covariances by F^2): --scale 0.001
                     for a CSV in millimetres (CONTACTS.csv only)
 readings (--readings, --session):
@@ -75,8 +78,8 @@ readings (--readings, --session):
   -h, --help        show this help
   --version         show taxel's version
 
-Prints the counts (contacts, added, fused, rejected by reason, points, points written) and the
-time per contact.
+Prints the counts (contacts, added, fused, rejected by reason, rows of CONTACTS.csv skipped,
+points, points written) and the time per contact.
 Exit status: 0 on success, 1 for unreadable input, 2 for bad options.
 )usage";
 
@@ -87,6 +90,7 @@ struct Options {
   double gate = 0.0;
   double process_noise = 0.0;
   bool ascii = false;
+  bool strict = false;
   std::uint32_t min_observations = 1;
   std::string readings, poses, session;
   bool per_pad = false;
@@ -96,6 +100,9 @@ struct Options {
   double scale = 1.0;
   std::vector<std::string> files;
 };
+
+// Rows of CONTACTS.csv skipped as bad (not --strict), for the summary.
+std::size_t skipped_rows = 0;
 
 template <class Cloud>
 int fuse(const Options& o, typename Cloud::Config cfg,
@@ -125,6 +132,7 @@ int fuse(const Options& o, typename Cloud::Config cfg,
   for (const auto& [why, n] : rejected) total_rejected += n;
   std::printf("rejected %zu", total_rejected);
   for (const auto& [why, n] : rejected) std::printf(" (%s %zu)", why.c_str(), n);
+  std::printf("\nskipped_rows %zu", skipped_rows);
   std::printf("\npoints %zu\ntime %.0f ns per contact\n", cloud.size(),
               contacts.empty() ? 0.0 : 1e9 * s / static_cast<double>(contacts.size()));
   if (o.policy != "raw" && fused == 0 && added >= 100) {  // raw never fuses
@@ -251,6 +259,8 @@ int main(int argc, char** argv) {
       o.min_observations = args.number<std::uint32_t>(1, 4294967295u);
     } else if (a == "--max-sigma") {
       o.max_sigma = args.number<double>(0.0, kInf);
+    } else if (a == "--strict") {
+      o.strict = true;
     } else if (a == "--ascii") {
       o.ascii = true;
     } else if (a == "--scale") {
@@ -325,7 +335,18 @@ int main(int argc, char** argv) {
                      o.session.c_str(), shortfall.c_str());
       }
     } else {
-      contacts = taxel::io::read_contacts_csv(o.files[0]);
+      taxel::io::ContactsCsvReport report;
+      contacts = taxel::io::read_contacts_csv(o.files[0], {.strict = o.strict}, &report);
+      for (const auto& c : report.ignored_columns) {
+        std::fprintf(stderr, "taxel-fuse: %s: ignoring unknown column '%s'\n", o.files[0].c_str(),
+                     c.c_str());
+      }
+      skipped_rows = report.skipped_rows;
+      if (report.skipped_rows > 0) {
+        std::fprintf(stderr,
+                     "taxel-fuse: skipped %zu bad rows (--strict refuses them); the first: %s\n",
+                     report.skipped_rows, report.first_skipped.c_str());
+      }
       if (o.scale != 1.0) {
         for (auto& c : contacts) {
           c.position *= o.scale;

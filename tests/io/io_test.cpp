@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <bit>
 #include <catch2/catch.hpp>
 #include <csignal>
@@ -440,6 +441,31 @@ TEST_CASE("Contacts CSV: round trip, foreign layouts, strict errors", "[io][csv]
     CHECK_THROWS_WITH(tio::parse_contacts_csv(text), Contains(message));
   }
   CHECK_THROWS_WITH(tio::read_contacts_csv("/nonexistent.csv"), Contains("cannot open"));
+  // Lenient: every bad row of the table above is skipped and counted, the first reason kept;
+  // unknown columns are named and ignored; a bad header is still refused.
+  for (const auto& [text, message] : bad) {
+    INFO(text);
+    tio::ContactsCsvReport report;
+    const std::string_view t(text);
+    if (t.find('\n') == std::string_view::npos || t.find('\n') == t.size() - 1) {
+      if (t.find(",w") == std::string_view::npos) {
+        CHECK_THROWS_WITH(tio::parse_contacts_csv(text, "<csv>", {.strict = false}, &report),
+                          Contains(message));
+      }
+      continue;  // header-only cases
+    }
+    const auto kept = tio::parse_contacts_csv(text, "<csv>", {.strict = false}, &report);
+    CHECK(report.skipped_rows == 1);
+    CHECK_THAT(report.first_skipped, Contains(message));
+    CHECK(kept.size() + 1 == static_cast<std::size_t>(std::count(t.begin(), t.end(), '\n')) - 1);
+  }
+  tio::ContactsCsvReport report;
+  const auto kept = tio::parse_contacts_csv("finger,x,y,z,side\n1,1,2,3,left\n2,4,5,6,right\n",
+                                            "<csv>", {.strict = false}, &report);
+  REQUIRE(kept.size() == 2);
+  CHECK(kept[1].position == taxel::Vec3d(4, 5, 6));
+  CHECK(report.ignored_columns == std::vector<std::string>{"finger", "side"});
+  CHECK(report.skipped_rows == 0);
 }
 
 TEST_CASE("PLY: a property named twice is refused, not silently reordered", "[io][ply]") {

@@ -9,10 +9,13 @@
 //                                                                      none; empty cells: no
 //                                                                      normal for that contact
 //   pressure                      pressure [Pa] or raw sensor units    optional (default 0)
-// Lines starting with '#' and blank lines are skipped; CRLF is accepted. The reader is strict:
-// unknown or repeated columns, missing values, malformed numbers and non-finite positions are
-// refused with the line and column. Covariance validity is ContactCloud's business (it rejects
-// and counts bad ones), so the reader keeps such contacts.
+// Lines starting with '#' and blank lines are skipped; CRLF is accepted. By default the reader
+// is strict: unknown or repeated columns, missing values, malformed numbers and non-finite
+// positions are refused with the line and column. With ContactsCsvOptions::strict = false,
+// unknown columns are ignored (and named in the report) and a bad row is skipped and counted
+// (the first one's reason kept), as ContactCloud rejects and counts bad contacts one by one; a
+// bad header is still refused. Covariance validity is ContactCloud's business (it rejects and
+// counts bad ones), so the reader keeps such contacts.
 #pragma once
 
 #include <array>
@@ -37,10 +40,29 @@ inline constexpr std::array<std::string_view, 14> kContactColumns{
 /// Largest number of contacts the reader accepts (2^26).
 inline constexpr std::size_t kMaxContacts = std::size_t{1} << 26;
 
+/// How forgiving the reader is.
+struct ContactsCsvOptions {
+  bool strict = true;  ///< false: skip bad rows and ignore unknown columns
+};
+
+/// What a lenient read left out.
+struct ContactsCsvReport {
+  std::size_t skipped_rows = 0;              ///< rows skipped as bad
+  std::string first_skipped;                 ///< "<source>:<line>: column <c>: why" of the first
+  std::vector<std::string> ignored_columns;  ///< unknown column names, in header order
+};
+
 /// Parses a contacts CSV held in memory. Throws IoError with "<source>:<line>: column <c>: ...".
+/// With `options.strict` false, bad rows and unknown columns go to `report` (when given)
+/// instead.
 template <class = void>
 inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
-                                                       const std::string& source = "<csv>") {
+                                                       const std::string& source = "<csv>",
+                                                       const ContactsCsvOptions& options = {},
+                                                       ContactsCsvReport* report = nullptr) {
+  ContactsCsvReport scratch;
+  ContactsCsvReport& rep = report != nullptr ? *report : scratch;
+  rep = {};
   std::vector<Contact<double>> out;
   std::array<int, kContactColumns.size()> where{};  // column index of each known name, or -1
   where.fill(-1);
@@ -70,6 +92,10 @@ inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
       for (std::size_t c = 0; c < cells.size(); ++c) {
         std::size_t k = 0;
         while (k < kContactColumns.size() && kContactColumns[k] != cells[c]) ++k;
+        if (k == kContactColumns.size() && !options.strict) {
+          rep.ignored_columns.emplace_back(cells[c]);
+          continue;
+        }
         if (k == kContactColumns.size()) {
           fail(c,
                "unknown column '" + std::string(cells[c].substr(0, 24)) +
@@ -92,58 +118,66 @@ inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
       have_header = true;
       continue;
     }
-    if (static_cast<int>(cells.size()) != columns) {
-      throw IoError(source,
-                    "row has " + std::to_string(cells.size()) + " values; the header has " +
-                        std::to_string(columns),
-                    line_no);
-    }
     if (out.size() >= kMaxContacts) {
       throw IoError(source, "more than " + std::to_string(kMaxContacts) + " contacts", line_no);
     }
-    const auto value = [&](std::size_t k, bool allow_empty) -> std::optional<double> {
-      const auto c = static_cast<std::size_t>(where[k]);
-      const std::string_view cell = cells[c];
-      if (cell.empty()) {
-        if (allow_empty) return std::nullopt;
-        fail(c, std::string(kContactColumns[k]) + " is empty");
+    try {
+      if (static_cast<int>(cells.size()) != columns) {
+        throw IoError(source,
+                      "row has " + std::to_string(cells.size()) + " values; the header has " +
+                          std::to_string(columns),
+                      line_no);
       }
-      double v = 0.0;
-      const auto res = std::from_chars(cell.data(), cell.data() + cell.size(), v);
-      if (res.ec != std::errc() || res.ptr != cell.data() + cell.size()) {
-        fail(c, "'" + std::string(cell.substr(0, 24)) + "' is not a number");
+      const auto value = [&](std::size_t k, bool allow_empty) -> std::optional<double> {
+        const auto c = static_cast<std::size_t>(where[k]);
+        const std::string_view cell = cells[c];
+        if (cell.empty()) {
+          if (allow_empty) return std::nullopt;
+          fail(c, std::string(kContactColumns[k]) + " is empty");
+        }
+        double v = 0.0;
+        const auto res = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+        if (res.ec != std::errc() || res.ptr != cell.data() + cell.size()) {
+          fail(c, "'" + std::string(cell.substr(0, 24)) + "' is not a number");
+        }
+        return v;
+      };
+      Contact<double> ct;
+      for (int a = 0; a < 3; ++a) ct.position[a] = *value(static_cast<std::size_t>(1 + a), false);
+      if (!ct.position.allFinite())
+        fail(static_cast<std::size_t>(where[1]), "the position is not finite");
+      if (where[0] >= 0) ct.time = *value(0, false);
+      if (where[4] >= 0) {
+        const double xx = *value(4, false), xy = *value(5, false), xz = *value(6, false);
+        const double yy = *value(7, false), yz = *value(8, false), zz = *value(9, false);
+        ct.covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
       }
-      return v;
-    };
-    Contact<double> ct;
-    for (int a = 0; a < 3; ++a) ct.position[a] = *value(static_cast<std::size_t>(1 + a), false);
-    if (!ct.position.allFinite())
-      fail(static_cast<std::size_t>(where[1]), "the position is not finite");
-    if (where[0] >= 0) ct.time = *value(0, false);
-    if (where[4] >= 0) {
-      const double xx = *value(4, false), xy = *value(5, false), xz = *value(6, false);
-      const double yy = *value(7, false), yz = *value(8, false), zz = *value(9, false);
-      ct.covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+      if (where[10] >= 0) {
+        const auto nx = value(10, true), ny = value(11, true), nz = value(12, true);
+        if (nx && ny && nz) {
+          ct.normal = Vec3d(*nx, *ny, *nz);
+        } else if (nx || ny || nz) {
+          fail(static_cast<std::size_t>(where[10]),
+               "a normal needs nx, ny and nz, or none of them");
+        }
+      }
+      if (where[13] >= 0) ct.pressure = *value(13, false);
+      out.push_back(ct);
+    } catch (const IoError& e) {
+      if (options.strict) throw;
+      if (rep.skipped_rows++ == 0) rep.first_skipped = e.what();
     }
-    if (where[10] >= 0) {
-      const auto nx = value(10, true), ny = value(11, true), nz = value(12, true);
-      if (nx && ny && nz) {
-        ct.normal = Vec3d(*nx, *ny, *nz);
-      } else if (nx || ny || nz) {
-        fail(static_cast<std::size_t>(where[10]), "a normal needs nx, ny and nz, or none of them");
-      }
-    }
-    if (where[13] >= 0) ct.pressure = *value(13, false);
-    out.push_back(ct);
   }
   if (!have_header) throw IoError(source, "no header line (expected e.g. 'time,x,y,z')");
   return out;
 }
 
-/// Reads a contacts CSV file. Throws IoError.
+/// Reads a contacts CSV file. Throws IoError (see parse_contacts_csv for `options`).
 template <class = void>
-inline std::vector<Contact<double>> read_contacts_csv(const std::string& path) {
-  return parse_contacts_csv(read_file(path), path);
+inline std::vector<Contact<double>> read_contacts_csv(const std::string& path,
+                                                      const ContactsCsvOptions& options = {},
+                                                      ContactsCsvReport* report = nullptr) {
+  return parse_contacts_csv(read_file(path), path, options, report);
 }
 
 /// Encodes contacts with every column (kContactColumns); empty normal cells for contacts
