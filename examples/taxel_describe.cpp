@@ -24,7 +24,8 @@ constexpr const char* kUsage = R"(usage: taxel-describe [options] IMAGE...
 Describes pressure images as the second paper does: k-means segmentation, the union of the
 high-pressure regions (HPRs), MATLAB-convention region descriptors, the 23 edged/edgeless
 features, the edged decision and, with --hybrid, the 1035-long hybrid vector.
-IMAGE is a .csv (one row per line), .pgm (P2/P5, 8/16 bit; several frames allowed) or .npy
+IMAGE is a .csv or .txt (one row per line, values separated by commas or, as numpy's
+np.savetxt writes them, by spaces), .pgm (P2/P5, 8/16 bit; several frames allowed) or .npy
 (2-D image or 3-D stack of frames) file. One output record per frame.
 
 With --format libsvm the output is a training file for taxel-train (or LIBLINEAR): one line

@@ -64,10 +64,21 @@ TEST_CASE("CSV images: round trip and strict errors", "[io]") {
                     Contains("f.csv:2") && Contains("the first row has 3"));
   CHECK_THROWS_WITH(tio::parse_image_csv("1,2\n3,x\n", "f.csv"),
                     Contains("f.csv:2") && Contains("column 2") && Contains("'x'"));
-  CHECK_THROWS_WITH(tio::parse_image_csv("1,,2\n"), Contains("column 2: empty value"));
-  CHECK_THROWS_WITH(tio::parse_image_csv("1,nan\n"), Contains("not finite"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("1,,2\n"),
+                    Contains("column 2 (pixel row 0, column 1): empty value"));
+  // A bad pixel is named by its row and column (0-based) and its text.
+  CHECK_THROWS_WITH(
+      tio::parse_image_csv("1,2\n3,nan\n", "n.csv"),
+      Contains("n.csv:2: column 2 (pixel row 1, column 1): value 'nan' is not finite"));
   CHECK_THROWS_WITH(tio::parse_image_csv("1,inf\n"), Contains("not finite"));
-  CHECK_THROWS_WITH(tio::parse_image_csv("1 2\n"), Contains("expected ','"));
+  CHECK_THROWS_WITH(tio::parse_image_csv("1,2 3\n"), Contains("expected ','"));
+  // numpy's np.savetxt default: whitespace-separated, exponent notation.
+  const tio::ImageStack ws =
+      tio::parse_image_csv("1.000000000000000000e+00 2.5e+00\t3\n  4 5 6.0e-01\n");
+  REQUIRE((ws.rows == 2 && ws.cols == 3));
+  CHECK(ws.frame(0)(0, 1) == 2.5);
+  CHECK(ws.frame(0)(1, 2) == 0.6);
+  CHECK_THROWS_WITH(tio::parse_image_csv("1 2 3\n4 5\n"), Contains("the first row has 3"));
   CHECK_THROWS_WITH(tio::parse_image_csv("\n# only a comment\n", "e.csv"),
                     Contains("e.csv") && Contains("empty"));
   CHECK_THROWS_AS(tio::parse_image_csv(""), taxel::IoError);
@@ -170,6 +181,15 @@ TEST_CASE("NPY images: dtypes, stacks, Fortran order, versions, strict errors", 
   CHECK_THROWS_WITH(
       tio::parse_npy(npy("<f8", "(1, 1)", std::string(reinterpret_cast<const char*>(&nan), 8))),
       Contains("not finite"));
+  // The bad pixel by frame, row and column, in C and in Fortran order: a (2, 2, 3) stack whose
+  // element 9 (C order: frame 1, row 1, column 0; Fortran: frame 1, row 0, column 2) is NaN.
+  double stack[12] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 0, 10, 11};
+  stack[9] = nan;
+  const std::string raw(reinterpret_cast<const char*>(stack), sizeof stack);
+  CHECK_THROWS_WITH(tio::parse_npy(npy("<f8", "(2, 2, 3)", raw), "s.npy"),
+                    Contains("pixel (row 1, column 0) of frame 1 is not finite (nan)"));
+  CHECK_THROWS_WITH(tio::parse_npy(npy("<f8", "(2, 2, 3)", raw, true), "s.npy"),
+                    Contains("pixel (row 0, column 2) of frame 1 is not finite (nan)"));
   std::string cut = npy("|u1", "(1, 1)", "a");
   cut.resize(20);
   CHECK_THROWS_WITH(tio::parse_npy(cut), Contains("header of"));

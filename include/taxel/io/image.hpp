@@ -74,6 +74,9 @@ inline ImageStack parse_image_csv(std::string_view text, const std::string& sour
   while (lines.next(line)) {
     const std::uint64_t line_no = lines.line_number();
     if (blank_or_comment(line)) continue;
+    // Values are separated by commas or, on a line without commas, by whitespace (numpy's
+    // np.savetxt default).
+    const bool commas = line.find(',') != std::string_view::npos;
     Eigen::Index cols = 0;
     std::size_t i = 0;
     while (true) {
@@ -81,7 +84,9 @@ inline ImageStack parse_image_csv(std::string_view text, const std::string& sour
       const std::size_t start = i;
       while (i < line.size() && line[i] != ',' && line[i] != ' ' && line[i] != '\t') ++i;
       const std::string_view field = line.substr(start, i - start);
-      const std::string where = "column " + std::to_string(cols + 1) + ": ";
+      const std::string where = "column " + std::to_string(cols + 1) + " (pixel row " +
+                                std::to_string(out.rows) + ", column " + std::to_string(cols) +
+                                "): ";
       if (field.empty()) throw IoError(source, where + "empty value", line_no);
       double v = 0;
       const char* b = field.data();
@@ -92,7 +97,7 @@ inline ImageStack parse_image_csv(std::string_view text, const std::string& sour
         throw IoError(source, where + "'" + std::string(field) + "' is not a number", line_no);
       }
       if (!std::isfinite(v)) {
-        throw IoError(source, where + "value is not finite", line_no);
+        throw IoError(source, where + "value '" + std::string(field) + "' is not finite", line_no);
       }
       if (out.values.size() >= kMaxImageValues) {
         throw IoError(source, "more than " + std::to_string(kMaxImageValues) + " values", line_no);
@@ -101,6 +106,7 @@ inline ImageStack parse_image_csv(std::string_view text, const std::string& sour
       ++cols;
       while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
       if (i == line.size()) break;
+      if (!commas) continue;
       if (line[i] != ',') {
         throw IoError(source, where + "expected ',' between values", line_no);
       }
@@ -369,9 +375,25 @@ inline ImageStack parse_npy(std::string_view bytes, const std::string& source = 
     } else {
       v = std::bit_cast<double>(raw);
     }
-    if (!std::isfinite(v)) {
+    if (!std::isfinite(v)) {  // name the pixel: (frame, row, column) of element k
+      const std::uint64_t per_frame = rows * cols;
+      std::uint64_t f = 0, r = 0, c = 0;
+      if (fortran) {
+        f = k % frames;
+        r = (k / frames) % rows;
+        c = k / (frames * rows);
+      } else {
+        f = k / per_frame;
+        r = (k % per_frame) / cols;
+        c = k % cols;
+      }
       detail::fail_at_byte(source, static_cast<std::size_t>(p - bytes.data()),
-                           "value " + std::to_string(k) + " is not finite");
+                           "pixel (row " + std::to_string(r) + ", column " + std::to_string(c) +
+                               ") of frame " + std::to_string(f) + " is not finite (" +
+                               (std::isnan(v) ? "nan"
+                                : v > 0       ? "inf"
+                                              : "-inf") +
+                               ")");
     }
     // Fortran order stores the whole array column-major: element (f, r, c) is at
     // f + frames * (r + rows * c).
