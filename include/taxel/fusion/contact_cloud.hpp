@@ -276,8 +276,8 @@ class ContactCloud {
     if (r > Scalar(1)) {  // no tactile contact is gated at a metre: a length in millimetres
       throw std::invalid_argument(
           "ContactCloud::Config::association_radius = " + std::to_string(r) +
-          " m looks like millimetres; taxel uses metres (" + std::to_string(r) + " mm = " +
-          std::to_string(r / Scalar(1000)) + ")");
+          " m looks like millimetres; taxel uses metres (" + std::to_string(r) +
+          " mm = " + std::to_string(r / Scalar(1000)) + ")");
     }
     return config;
   }
