@@ -2,6 +2,7 @@
 // taxel-describe: pressure images (CSV, PGM, NPY; stacks too) in, the second paper's
 // descriptors and features out, one line (CSV) or object (JSON) per frame.
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cstdio>
 #include <exception>
@@ -12,6 +13,10 @@
 #include <taxel/io.hpp>
 #include <taxel/learn/dataset.hpp>
 #include <vector>
+
+#ifdef TAXEL_DESCRIBE_HAVE_PNG
+#include <taxel/io/png.hpp>
+#endif
 
 #include "cli.hpp"
 
@@ -25,8 +30,8 @@ Describes pressure images as the second paper does: k-means segmentation, the un
 high-pressure regions (HPRs), MATLAB-convention region descriptors, the 23 edged/edgeless
 features, the edged decision and, with --hybrid, the 1035-long hybrid vector.
 IMAGE is a .csv or .txt (one row per line, values separated by commas or, as numpy's
-np.savetxt writes them, by spaces), .pgm (P2/P5, 8/16 bit; several frames allowed) or .npy
-(2-D image or 3-D stack of frames) file. One output record per frame.
+np.savetxt writes them, by spaces), .pgm (P2/P5, 8/16 bit; several frames allowed), .png
+(greyscale, 8/16 bit, the samples as stored) or .npy (2-D image or 3-D stack of frames) file. One output record per frame.
 
 With --format libsvm the output is a training file for taxel-train (or LIBLINEAR): one line
 per frame, its label from --labels, then the 11 regional features (conventional recognition)
@@ -149,13 +154,28 @@ std::vector<int> read_labels(const std::string& path) {
   return labels;
 }
 
+// An image file: .png through libpng when built with it, the rest by io::read_image.
+taxel::io::ImageStack load_image(const std::string& path) {
+  const std::size_t dot = path.find_last_of('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  for (auto& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext == ".png") {
+#ifdef TAXEL_DESCRIBE_HAVE_PNG
+    return taxel::io::read_png_image(path);
+#else
+    throw taxel::IoError(path, "PNG input needs taxel-describe built with libpng");
+#endif
+  }
+  return taxel::io::read_image(path);
+}
+
 // --format libsvm: every frame's features with its label.
 std::string describe_libsvm(const Options& opt) {
   const std::vector<int> labels = read_labels(opt.labels);
   taxel::learn::Dataset d;
   std::vector<Eigen::VectorXd> rows;
   for (const std::string& path : opt.inputs) {
-    const taxel::io::ImageStack stack = taxel::io::read_image(path);
+    const taxel::io::ImageStack stack = load_image(path);
     ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg, ti::GradientThreshold{opt.threshold});
     for (Eigen::Index f = 0; f < stack.frames; ++f) {
       const ti::Recognition& r = rec.recognize(stack.frame(f));
@@ -199,7 +219,7 @@ int main(int argc, char** argv) try {
   }
   bool first = true;
   for (const std::string& path : opt.libsvm ? std::vector<std::string>{} : opt.inputs) {
-    const taxel::io::ImageStack stack = taxel::io::read_image(path);
+    const taxel::io::ImageStack stack = load_image(path);
     ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg, ti::GradientThreshold{opt.threshold});
     ti::RegionAnalyzer props({}, stack.rows, stack.cols);
     for (Eigen::Index f = 0; f < stack.frames; ++f) {

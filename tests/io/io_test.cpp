@@ -15,6 +15,7 @@
 #include <taxel/io.hpp>
 
 #if defined(TAXEL_TEST_HAVE_PNG)
+#include <zlib.h>
 #include <taxel/io/png.hpp>
 #endif
 
@@ -230,9 +231,72 @@ TEST_CASE("image files by extension, pictures", "[io]") {
   CHECK(again.rows == both.rows);
   CHECK(again.data == both.data);
   CHECK_THROWS_AS(tio::read_png((dir / "a.csv").string()), taxel::IoError);
+  CHECK_THROWS_WITH(tio::read_png_image((dir / "p.png").string()),
+                    Contains("p.png") && Contains("a colour PNG"));
 #endif
   std::filesystem::remove_all(dir);
 }
+
+#if defined(TAXEL_TEST_HAVE_PNG)
+namespace {
+// A greyscale PNG built by hand (signature, IHDR, one zlib IDAT with filter 0 rows, IEND; no
+// gamma chunk), independent of libpng's writer: samples big-endian at 16 bits.
+std::string grey_png(std::uint32_t width, std::uint32_t height, int bits,
+                     const std::vector<unsigned>& samples) {
+  const auto be32 = [](std::uint32_t v) {
+    return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16),
+                       static_cast<char>(v >> 8), static_cast<char>(v)};
+  };
+  const auto chunk = [&](const std::string& type, const std::string& data) {
+    const std::string body = type + data;
+    const auto crc = static_cast<std::uint32_t>(
+        crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size())));
+    return be32(static_cast<std::uint32_t>(data.size())) + body + be32(crc);
+  };
+  std::string raw;
+  for (std::uint32_t r = 0; r < height; ++r) {
+    raw.push_back('\0');  // filter type 0
+    for (std::uint32_t c = 0; c < width; ++c) {
+      const unsigned v = samples[r * width + c];
+      if (bits == 16) raw.push_back(static_cast<char>(v >> 8));
+      raw.push_back(static_cast<char>(v & 0xFF));
+    }
+  }
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::string z(size, '\0');
+  REQUIRE(compress(reinterpret_cast<Bytef*>(z.data()), &size,
+                   reinterpret_cast<const Bytef*>(raw.data()),
+                   static_cast<uLong>(raw.size())) == Z_OK);
+  z.resize(size);
+  const std::string ihdr =
+      be32(width) + be32(height) + std::string{static_cast<char>(bits), 0, 0, 0, 0};
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", z) +
+         chunk("IEND", "");
+}
+}  // namespace
+
+TEST_CASE("PNG pressure images: 8 and 16-bit greyscale samples as stored", "[io][png]") {
+  const auto dir = std::filesystem::temp_directory_path() / "taxel_png_image_test";
+  std::filesystem::create_directories(dir);
+  const std::vector<unsigned> wide{0, 1, 258, 4095, 40000, 65535};
+  tio::write_file((dir / "w.png").string(), grey_png(3, 2, 16, wide));
+  const tio::ImageStack w = tio::read_png_image((dir / "w.png").string());
+  REQUIRE((w.frames == 1 && w.rows == 2 && w.cols == 3));
+  for (std::size_t i = 0; i < wide.size(); ++i) CHECK(w.values[i] == double(wide[i]));
+  CHECK(w.frame(0)(1, 0) == 4095);
+  const std::vector<unsigned> narrow{0, 7, 128, 255};
+  tio::write_file((dir / "n.png").string(), grey_png(2, 2, 8, narrow));
+  const tio::ImageStack n = tio::read_png_image((dir / "n.png").string());
+  REQUIRE((n.rows == 2 && n.cols == 2));
+  for (std::size_t i = 0; i < narrow.size(); ++i) CHECK(n.values[i] == double(narrow[i]));
+  std::string cut = grey_png(3, 2, 16, wide);
+  cut.resize(cut.size() - 20);
+  tio::write_file((dir / "cut.png").string(), cut);
+  CHECK_THROWS_WITH(tio::read_png_image((dir / "cut.png").string()),
+                    Contains("cut.png") && Contains("PNG read failed"));
+  std::filesystem::remove_all(dir);
+}
+#endif
 
 TEST_CASE("SVG line plots: points, legend, escaping, reversed axis, errors", "[io][svg]") {
   namespace tio = taxel::io;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// PNG output through libpng's simplified API. This header needs libpng at link time: link the
-// CMake target taxel::png (defined when libpng is found) or add -lpng.
+// PNG through libpng's simplified API: pictures out and in, and greyscale pressure images in.
+// This header needs libpng at link time: link the CMake target taxel::png (defined when libpng
+// is found) or add -lpng.
 #pragma once
 
 #include <png.h>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "taxel/core/error.hpp"
+#include "taxel/io/image.hpp"
 #include "taxel/io/picture.hpp"
 
 namespace taxel::io {
@@ -49,6 +51,58 @@ inline RgbImage read_png(const std::string& path) {
     throw IoError(path, "PNG read failed: " + why);
   }
   return img;
+}
+
+/// Reads a greyscale PNG (8 or 16 bits per sample) as a one-frame pressure image, the samples as
+/// stored: 0..255 or 0..65535. (A file with a gamma or sRGB chunk is converted by libpng: an
+/// 8-bit file to sRGB, a 16-bit one to linear; files from sensors and numpy carry none.) Throws
+/// IoError for an unreadable file, a colour image or one with an alpha channel, naming the
+/// file.
+template <class = void>
+inline ImageStack read_png_image(const std::string& path) {
+  const std::string bytes = read_file(path);
+  png_image desc{};
+  desc.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_memory(&desc, bytes.data(), bytes.size()) == 0) {
+    throw IoError(path, std::string("PNG read failed: ") + desc.message);
+  }
+  const auto refuse = [&](const std::string& why) {
+    png_image_free(&desc);
+    throw IoError(path, why);
+  };
+  if ((desc.format & PNG_FORMAT_FLAG_COLOR) != 0) {
+    refuse("a colour PNG; a pressure image must be greyscale (8 or 16 bits)");
+  }
+  if ((desc.format & PNG_FORMAT_FLAG_ALPHA) != 0) {
+    refuse("a PNG with an alpha channel; a pressure image must be plain greyscale");
+  }
+  try {
+    detail::check_size(path, 1, desc.height, desc.width, 16);  // IHDR's width is at byte 16
+  } catch (...) {
+    png_image_free(&desc);
+    throw;
+  }
+  const bool wide = (desc.format & PNG_FORMAT_FLAG_LINEAR) != 0;  // 16 bits per sample
+  desc.format = wide ? PNG_FORMAT_LINEAR_Y : PNG_FORMAT_GRAY;
+  ImageStack out;
+  out.frames = 1;
+  out.rows = static_cast<Eigen::Index>(desc.height);
+  out.cols = static_cast<Eigen::Index>(desc.width);
+  const std::size_t n = static_cast<std::size_t>(desc.height) * desc.width;
+  std::vector<std::uint16_t> wide_samples(wide ? n : 0);
+  std::vector<std::uint8_t> narrow_samples(wide ? 0 : n);
+  void* buffer =
+      wide ? static_cast<void*>(wide_samples.data()) : static_cast<void*>(narrow_samples.data());
+  if (png_image_finish_read(&desc, nullptr, buffer, 0, nullptr) == 0) {
+    const std::string why = desc.message;
+    png_image_free(&desc);
+    throw IoError(path, "PNG read failed: " + why);
+  }
+  out.values.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.values[i] = wide ? double(wide_samples[i]) : double(narrow_samples[i]);
+  }
+  return out;
 }
 
 }  // namespace taxel::io
