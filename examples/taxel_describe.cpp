@@ -2,7 +2,6 @@
 // taxel-describe: pressure images (CSV, PGM, NPY; stacks too) in, the second paper's
 // descriptors and features out, one line (CSV) or object (JSON) per frame.
 #include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <cstdio>
 #include <exception>
@@ -156,10 +155,7 @@ std::vector<int> read_labels(const std::string& path) {
 
 // An image file: .png through libpng when built with it, the rest by io::read_image.
 taxel::io::ImageStack load_image(const std::string& path) {
-  const std::size_t dot = path.find_last_of('.');
-  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  for (auto& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (ext == ".png") {
+  if (taxel::io::extension(path) == ".png") {
 #ifdef TAXEL_DESCRIBE_HAVE_PNG
     return taxel::io::read_png_image(path);
 #else
