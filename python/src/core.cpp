@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: MIT
+// taxel.PointCloud and taxel.Contacts: the containers the other modules pass around.
+#include "common.hpp"
+
+namespace taxel::python {
+
+Cloud cloud_from(const ArrayD& points, const std::optional<ArrayD>& normals, const char* what) {
+  Cloud c;
+  c.points = points_from(points, what);
+  if (normals) {
+    c.normals = points_from(*normals, "normals");
+    if (c.normals.size() != c.points.size()) {
+      throw py::value_error(std::string(what) + ": " + std::to_string(c.normals.size()) +
+                            " normals for " + std::to_string(c.points.size()) + " points");
+    }
+  }
+  return c;
+}
+
+ContactRows contact_rows(ArrayD positions, std::optional<ArrayD> covariances,
+                         std::optional<ArrayD> normals, std::optional<ArrayD> pressures,
+                         std::optional<ArrayD> times, std::optional<double> sigma) {
+  require_shape(positions, {-1, 3}, "positions", "(N, 3)");
+  ContactRows r;
+  r.n = static_cast<std::size_t>(positions.shape(0));
+  const auto n = static_cast<py::ssize_t>(r.n);
+  if (covariances && sigma) {
+    throw py::value_error("give covariances or sigma, not both");
+  }
+  if (sigma) {
+    r.default_covariance = isotropic_covariance(*sigma);  // throws for sigma <= 0
+  }
+  if (covariances) {
+    if (covariances->ndim() == 2) {
+      require_shape(*covariances, {3, 3}, "covariances", "(N, 3, 3) or (3, 3)");
+    } else {
+      require_shape(*covariances, {n, 3, 3}, "covariances", "(N, 3, 3) or (3, 3)");
+    }
+  }
+  if (normals) require_shape(*normals, {n, 3}, "normals", "(N, 3) like positions");
+  if (pressures) require_shape(*pressures, {n}, "pressures", "(N,) like positions");
+  if (times) require_shape(*times, {n}, "times", "(N,) like positions");
+  r.positions = std::move(positions);
+  r.covariances = std::move(covariances);
+  r.normals = std::move(normals);
+  r.pressures = std::move(pressures);
+  r.times = std::move(times);
+  return r;
+}
+
+namespace {
+
+ArrayD covariances_array(const ContactList& cs) {
+  ArrayD out({static_cast<py::ssize_t>(cs.size()), py::ssize_t{3}, py::ssize_t{3}});
+  double* p = out.mutable_data();
+  for (const auto& c : cs) {
+    store(p, c.covariance);
+    p += 9;
+  }
+  return out;
+}
+
+}  // namespace
+
+void bind_core(py::module_& m) {
+  py::class_<Cloud>(m, "PointCloud", R"doc(
+Points [m] with optional unit normals and named per-point scalar fields.
+
+Arrays are copied in and out: ``cloud.points`` is an (N, 3) float64 array, ``cloud.normals``
+an (N, 3) array or None, ``cloud.fields`` a dict of (N,) arrays.)doc")
+      .def(py::init([](ArrayD points, std::optional<ArrayD> normals,
+                       std::optional<std::map<std::string, ArrayD>> fields) {
+             Cloud c = cloud_from(points, normals, "points");
+             if (fields) {
+               for (const auto& [name, values] : *fields) {
+                 require_shape(values, {static_cast<py::ssize_t>(c.size())}, name.c_str(),
+                               "(N,) like points");
+                 c.fields.push_back(
+                     {name, std::vector<double>(values.data(), values.data() + values.size())});
+               }
+             }
+             return c;
+           }),
+           py::arg("points"), py::arg("normals") = py::none(), py::arg("fields") = py::none())
+      .def("__len__", &Cloud::size)
+      .def_property_readonly(
+          "points", [](const Cloud& c) { return points_array(c.points); }, "(N, 3) positions [m]")
+      .def_property_readonly(
+          "normals",
+          [](const Cloud& c) -> std::optional<ArrayD> {
+            if (!c.has_normals()) return std::nullopt;
+            return points_array(c.normals);
+          },
+          "(N, 3) unit normals, or None")
+      .def_property_readonly(
+          "fields",
+          [](const Cloud& c) {
+            std::map<std::string, py::array_t<double>> out;
+            for (const auto& f : c.fields) out[f.name] = vector_array(f.values);
+            return out;
+          },
+          "per-point scalars by name")
+      .def("__repr__", [](const Cloud& c) {
+        return "PointCloud(" + std::to_string(c.size()) + " points" +
+               (c.has_normals() ? ", normals" : "") +
+               (c.fields.empty() ? "" : ", " + std::to_string(c.fields.size()) + " fields") + ")";
+      });
+
+  py::class_<ContactList>(m, "Contacts", R"doc(
+Tactile contacts held in C++: positions [m] (world frame), covariances [m^2], optional unit
+normals (a NaN row when absent), pressures and times [s].
+
+Made from arrays, or returned by the readers, the simulator and
+``taxel.sensor.contacts_from_readings``. Inserting a ``Contacts`` into a ``ContactCloud`` runs
+the C++ loop with no conversion.)doc")
+      .def(py::init([](ArrayD positions, std::optional<ArrayD> covariances,
+                       std::optional<ArrayD> normals, std::optional<ArrayD> pressures,
+                       std::optional<ArrayD> times, std::optional<double> sigma) {
+             const ContactRows rows =
+                 contact_rows(std::move(positions), std::move(covariances), std::move(normals),
+                              std::move(pressures), std::move(times), sigma);
+             ContactList out(rows.n);
+             for (std::size_t i = 0; i < rows.n; ++i) out[i] = rows.at(i);
+             return out;
+           }),
+           py::arg("positions"), py::arg("covariances") = py::none(),
+           py::arg("normals") = py::none(), py::arg("pressures") = py::none(),
+           py::arg("times") = py::none(), py::arg("sigma") = py::none(),
+           "Contacts from (N, 3) positions; covariances (N, 3, 3) or one (3, 3) for all, or an "
+           "isotropic `sigma` [m]; the default is 1 mm isotropic.")
+      .def("__len__", &ContactList::size)
+      .def_property_readonly(
+          "positions",
+          [](const ContactList& cs) {
+            ArrayD out({static_cast<py::ssize_t>(cs.size()), py::ssize_t{3}});
+            double* p = out.mutable_data();
+            for (const auto& c : cs) {
+              store(p, c.position);
+              p += 3;
+            }
+            return out;
+          },
+          "(N, 3) positions [m]")
+      .def_property_readonly("covariances", &covariances_array, "(N, 3, 3) covariances [m^2]")
+      .def_property_readonly(
+          "normals",
+          [](const ContactList& cs) {
+            ArrayD out({static_cast<py::ssize_t>(cs.size()), py::ssize_t{3}});
+            double* p = out.mutable_data();
+            for (const auto& c : cs) {
+              store(p, c.normal ? *c.normal : Vec3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+              p += 3;
+            }
+            return out;
+          },
+          "(N, 3) unit normals; NaN rows where a contact has none")
+      .def_property_readonly(
+          "pressures",
+          [](const ContactList& cs) {
+            py::array_t<double> out(static_cast<py::ssize_t>(cs.size()));
+            for (std::size_t i = 0; i < cs.size(); ++i) out.mutable_data()[i] = cs[i].pressure;
+            return out;
+          },
+          "(N,) pressures")
+      .def_property_readonly(
+          "times",
+          [](const ContactList& cs) {
+            py::array_t<double> out(static_cast<py::ssize_t>(cs.size()));
+            for (std::size_t i = 0; i < cs.size(); ++i) out.mutable_data()[i] = cs[i].time;
+            return out;
+          },
+          "(N,) times [s]")
+      .def("__repr__",
+           [](const ContactList& cs) { return "Contacts(" + std::to_string(cs.size()) + ")"; });
+}
+
+}  // namespace taxel::python

@@ -1,0 +1,31 @@
+# SPDX-License-Identifier: MIT
+"""taxel: tactile perception for robot hands, grippers and prostheses.
+
+Fusion of contact streams into compact clouds (Meier et al. 2011), ICP and object recognition,
+pressure-image segmentation, region descriptors, reconstruction and classifiers, with numpy
+arrays in and out. Lengths are in metres, angles in radians, unless a name says otherwise.
+"""
+import sys as _sys
+
+from . import _taxel
+from ._taxel import Contacts, IoError, PointCloud, ProtocolError, __version__
+from ._taxel import fusion, image, io, learn, registration, sensor, sim
+
+# `import taxel.fusion` and `from taxel.image import segment` work like for any package.
+for _name in ("fusion", "image", "io", "learn", "registration", "sensor", "sim"):
+    _sys.modules[f"{__name__}.{_name}"] = getattr(_taxel, _name)
+
+__all__ = [
+    "Contacts",
+    "IoError",
+    "PointCloud",
+    "ProtocolError",
+    "__version__",
+    "fusion",
+    "image",
+    "io",
+    "learn",
+    "registration",
+    "sensor",
+    "sim",
+]
