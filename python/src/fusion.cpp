@@ -156,9 +156,8 @@ std::unique_ptr<CloudBase> with_index(int index, const CloudOptions& o) {
 /// Refuses an option that the chosen policy or index would ignore.
 void check_unused(const CloudOptions& o, int policy, int index) {
   const CloudOptions d;
-  const auto refuse = [](const char* option, const char* applies) {
-    throw py::value_error(std::string("ContactCloud: ") + option + " belong(s) to " + applies +
-                          " only");
+  const auto refuse = [](const char* options, const char* owner) {
+    throw py::value_error(std::string("ContactCloud: set ") + options + " only with " + owner);
   };
   const bool kalman_like = policy == 0 || policy == 1;
   if (!kalman_like) {

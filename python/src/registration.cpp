@@ -1,4 +1,289 @@
+// SPDX-License-Identifier: MIT
+// taxel.registration: Target, Icp (both errors, every kernel) and ObjectLibrary.
+#include <span>
+
 #include "common.hpp"
+#include "taxel/registration.hpp"
+
 namespace taxel::python {
-void bind_registration(py::module_& m) { m.def_submodule("registration"); }
+namespace {
+
+namespace reg = taxel::registration;
+
+std::span<const Vec3d> points_view(const ArrayD& a, const char* what) {
+  require_shape(a, {-1, 3}, what, "(N, 3)");
+  return {reinterpret_cast<const Vec3d*>(a.data()), static_cast<std::size_t>(a.shape(0))};
 }
+
+constexpr std::pair<std::string_view, int> kErrors[] = {{"point_to_plane", 0},
+                                                        {"point_to_point", 1}};
+constexpr std::pair<std::string_view, int> kKernels[] = {
+    {"none", 0}, {"huber", 1}, {"cauchy", 2}, {"geman_mcclure", 3}, {"tukey", 4}};
+
+/// The Python Icp: the error and kernel chosen by name.
+struct PyIcp {
+  std::string error, kernel;
+  double kernel_scale;
+  reg::IcpConfig config;
+};
+
+template <class E, class K>
+reg::IcpResult align_with(const PyIcp& icp, K kernel, const reg::Target<double>& target,
+                          std::span<const Vec3d> source, const Isometry3d& initial) {
+  reg::Icp<E, K> solver(icp.config, kernel);
+  return solver.align(target, source, initial);
+}
+
+template <class E>
+reg::IcpResult align_error(const PyIcp& icp, const reg::Target<double>& target,
+                           std::span<const Vec3d> source, const Isometry3d& initial) {
+  const double s = icp.kernel_scale;
+  switch (enum_from(icp.kernel, kKernels, "kernel")) {
+    case 1:
+      return align_with<E>(icp, reg::Huber{s}, target, source, initial);
+    case 2:
+      return align_with<E>(icp, reg::Cauchy{s}, target, source, initial);
+    case 3:
+      return align_with<E>(icp, reg::GemanMcClure{s}, target, source, initial);
+    case 4:
+      return align_with<E>(icp, reg::Tukey{s}, target, source, initial);
+    default:
+      return align_with<E>(icp, reg::NoKernel{}, target, source, initial);
+  }
+}
+
+double default_scale(const std::string& kernel) {
+  switch (enum_from(kernel, kKernels, "kernel")) {
+    case 1:
+      return reg::Huber{}.scale;
+    case 2:
+      return reg::Cauchy{}.scale;
+    case 3:
+      return reg::GemanMcClure{}.scale;
+    case 4:
+      return reg::Tukey{}.scale;
+    default:
+      return 0.0;
+  }
+}
+
+}  // namespace
+
+void bind_registration(py::module_& root) {
+  py::module_ m = root.def_submodule("registration", "ICP alignment and object recognition");
+
+  py::class_<reg::Target<double>>(m, "Target", R"doc(
+A model prepared for registration: points [m], unit normals (given, or estimated by PCA over
+`normal_neighbors` points and oriented away from the centroid), a nearest-neighbour grid and,
+with field_cell > 0 [m], a closest-point field for approximate correspondences.)doc")
+      .def(py::init([](const ArrayD& points, const std::optional<ArrayD>& normals,
+                       int normal_neighbors, bool recompute_normals, double grid_spacing_factor,
+                       double field_cell, double field_margin, std::size_t field_max_cells) {
+             reg::TargetConfig cfg;
+             cfg.normal_neighbors = normal_neighbors;
+             cfg.recompute_normals = recompute_normals;
+             cfg.grid_spacing_factor = grid_spacing_factor;
+             cfg.field_cell = field_cell;
+             cfg.field_margin = field_margin;
+             cfg.field_max_cells = field_max_cells;
+             Cloud c = cloud_from(points, normals, "points");
+             py::gil_scoped_release release;
+             return reg::Target<double>(std::move(c), cfg);
+           }),
+           py::arg("points"), py::arg("normals") = py::none(), py::kw_only(),
+           py::arg("normal_neighbors") = 12, py::arg("recompute_normals") = false,
+           py::arg("grid_spacing_factor") = 4.0, py::arg("field_cell") = 0.0,
+           py::arg("field_margin") = 0.02, py::arg("field_max_cells") = std::size_t{1} << 22)
+      .def(py::init([](const Cloud& cloud, int normal_neighbors) {
+             reg::TargetConfig cfg;
+             cfg.normal_neighbors = normal_neighbors;
+             py::gil_scoped_release release;
+             return reg::Target<double>(cloud, cfg);
+           }),
+           py::arg("cloud"), py::kw_only(), py::arg("normal_neighbors") = 12,
+           "A target from a PointCloud (its normals when it has them).")
+      .def("__len__", &reg::Target<double>::size)
+      .def_property_readonly("points",
+                             [](const reg::Target<double>& t) { return points_array(t.points()); })
+      .def_property_readonly("normals",
+                             [](const reg::Target<double>& t) { return points_array(t.normals()); })
+      .def(
+          "nearest",
+          [](const reg::Target<double>& t, const ArrayD& queries) {
+            const auto q = points_view(queries, "queries");
+            py::array_t<std::int64_t> ids(static_cast<py::ssize_t>(q.size()));
+            py::array_t<double> dist(static_cast<py::ssize_t>(q.size()));
+            {
+              py::gil_scoped_release release;
+              for (std::size_t i = 0; i < q.size(); ++i) {
+                const auto hit = t.nearest_within(q[i], std::numeric_limits<double>::infinity());
+                ids.mutable_data()[i] = hit ? std::int64_t{hit->id} : -1;
+                dist.mutable_data()[i] = hit ? std::sqrt(hit->squared_distance)
+                                             : std::numeric_limits<double>::quiet_NaN();
+              }
+            }
+            return py::make_tuple(ids, dist);
+          },
+          py::arg("queries"),
+          "(ids, distances [m]) of the closest target point to each (N, 3) query; -1 and NaN "
+          "for a non-finite query");
+
+  py::class_<reg::IcpResult>(m, "IcpResult", "The outcome of one alignment.")
+      .def_property_readonly("status",
+                             [](const reg::IcpResult& r) { return std::string(to_string(r.status)); },
+                             "'ok', 'not_converged', 'degenerate' or 'invalid_input'")
+      .def_readonly("message", &reg::IcpResult::message)
+      .def_property_readonly("ok", [](const reg::IcpResult& r) { return r.ok(); })
+      .def_property_readonly("transform",
+                             [](const reg::IcpResult& r) { return pose_array(r.transform); },
+                             "T_target_source, a 4x4 matrix")
+      .def_readonly("rmse", &reg::IcpResult::rmse, "RMS distance of the inlier pairs [m]")
+      .def_readonly("inlier_fraction", &reg::IcpResult::inlier_fraction)
+      .def_readonly("inliers", &reg::IcpResult::inliers)
+      .def_readonly("skipped", &reg::IcpResult::skipped, "non-finite source points ignored")
+      .def_readonly("iterations", &reg::IcpResult::iterations)
+      .def("__repr__", [](const reg::IcpResult& r) {
+        return "IcpResult(status='" + std::string(to_string(r.status)) +
+               "', rmse=" + std::to_string(r.rmse) +
+               ", iterations=" + std::to_string(r.iterations) + ")";
+      });
+
+  py::class_<PyIcp>(m, "Icp", R"doc(
+Iterative closest point. error: 'point_to_plane' (default) or 'point_to_point'; kernel:
+'none', 'huber', 'cauchy', 'geman_mcclure' or 'tukey', with `kernel_scale` [m] (None: the
+kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.)doc")
+      .def(py::init([](const std::string& error, const std::string& kernel,
+                       std::optional<double> kernel_scale, int max_iterations,
+                       double max_distance, double trim_fraction, double translation_tolerance,
+                       double rotation_tolerance, double relative_error_tolerance,
+                       std::size_t min_correspondences, bool approximate,
+                       std::size_t coarse_points) {
+             enum_from(error, kErrors, "error");
+             reg::IcpConfig cfg{max_iterations,        max_distance,
+                                trim_fraction,         translation_tolerance,
+                                rotation_tolerance,    relative_error_tolerance,
+                                min_correspondences,   approximate,
+                                coarse_points};
+             (void)reg::Icp<>(cfg);  // validates the options
+             const double scale = kernel_scale.value_or(default_scale(kernel));
+             if (kernel != "none" && (!(scale > 0) || !std::isfinite(scale))) {
+               throw py::value_error("Icp: kernel_scale must be finite and > 0 [m]");
+             }
+             return PyIcp{error, kernel, scale, cfg};
+           }),
+           py::arg("error") = "point_to_plane", py::arg("kernel") = "none", py::kw_only(),
+           py::arg("kernel_scale") = py::none(), py::arg("max_iterations") = 50,
+           py::arg("max_distance") = std::numeric_limits<double>::infinity(),
+           py::arg("trim_fraction") = 0.0, py::arg("translation_tolerance") = 1e-6,
+           py::arg("rotation_tolerance") = 1e-6, py::arg("relative_error_tolerance") = 0.0,
+           py::arg("min_correspondences") = 0, py::arg("approximate") = false,
+           py::arg("coarse_points") = 0)
+      .def_readonly("error", &PyIcp::error)
+      .def_readonly("kernel", &PyIcp::kernel)
+      .def_readonly("kernel_scale", &PyIcp::kernel_scale)
+      .def(
+          "align",
+          [](const PyIcp& icp, const reg::Target<double>& target, const ArrayD& source,
+             const std::optional<ArrayD>& initial) {
+            const auto src = points_view(source, "source");
+            const Isometry3d t0 = initial ? pose_from(*initial, "initial") : Isometry3d::Identity();
+            py::gil_scoped_release release;
+            return icp.error == "point_to_point"
+                       ? align_error<reg::PointToPoint>(icp, target, src, t0)
+                       : align_error<reg::PointToPlane>(icp, target, src, t0);
+          },
+          py::arg("target"), py::arg("source"), py::arg("initial") = py::none(),
+          "Aligns source (N, 3) [m] to target from `initial` (4x4, default identity). Returns an "
+          "IcpResult; its transform maps source points into the target frame.");
+
+  py::class_<reg::ModelMatch>(m, "ModelMatch", "How well one model explains the cloud.")
+      .def_readonly("name", &reg::ModelMatch::name)
+      .def_readonly("model", &reg::ModelMatch::model, "index in the library")
+      .def_readonly("score", &reg::ModelMatch::score, "truncated RMS distance [m], lower is better")
+      .def_readonly("rmse", &reg::ModelMatch::rmse)
+      .def_readonly("inlier_fraction", &reg::ModelMatch::inlier_fraction)
+      .def_property_readonly("transform",
+                             [](const reg::ModelMatch& r) { return pose_array(r.transform); },
+                             "T_model_cloud, a 4x4 matrix")
+      .def_property_readonly(
+          "icp_status", [](const reg::ModelMatch& r) { return std::string(to_string(r.icp_status)); })
+      .def_readonly("exact", &reg::ModelMatch::exact)
+      .def_readonly("starts", &reg::ModelMatch::starts)
+      .def("__repr__", [](const reg::ModelMatch& r) {
+        return "ModelMatch(name='" + r.name + "', score=" + std::to_string(r.score) + ")";
+      });
+
+  py::class_<reg::ObjectRecognition>(m, "ObjectRecognition", "The answer of recognize().")
+      .def_property_readonly(
+          "status", [](const reg::ObjectRecognition& r) { return std::string(to_string(r.status)); })
+      .def_readonly("message", &reg::ObjectRecognition::message)
+      .def_readonly("ranking", &reg::ObjectRecognition::ranking, "ModelMatch list, best first")
+      .def_readonly("best", &reg::ObjectRecognition::best, "the best model's name, or 'unknown'")
+      .def_readonly("unknown", &reg::ObjectRecognition::unknown)
+      .def_readonly("margin", &reg::ObjectRecognition::margin,
+                    "second score - best score [m] (0 with one model)")
+      .def("__repr__", [](const reg::ObjectRecognition& r) {
+        return "ObjectRecognition(best='" + r.best + "', margin=" + std::to_string(r.margin) + ")";
+      });
+
+  py::class_<reg::ObjectLibrary<double>>(m, "ObjectLibrary", R"doc(
+Named object models; recognize() ranks them by how well each explains a cloud (multi-start
+point-to-plane ICP, then a truncated RMS score [m]).)doc")
+      .def(py::init([](int coarse_iterations, std::size_t coarse_points,
+                       std::size_t refine_points, double coarse_trim, bool pca_starts,
+                       int rotation_starts, int refine_best, int exact_models,
+                       double hopeless_factor, double field_cell, double score_gate,
+                       double unknown_score) {
+             reg::LibraryConfig c;
+             c.coarse_iterations = coarse_iterations;
+             c.coarse_points = coarse_points;
+             c.refine_points = refine_points;
+             c.coarse_trim = coarse_trim;
+             c.pca_starts = pca_starts;
+             c.rotation_starts = rotation_starts;
+             c.refine_best = refine_best;
+             c.exact_models = exact_models;
+             c.hopeless_factor = hopeless_factor;
+             c.field_cell = field_cell;
+             c.score_gate = score_gate;
+             c.unknown_score = unknown_score;
+             return reg::ObjectLibrary<double>(c);
+           }),
+           py::kw_only(), py::arg("coarse_iterations") = 10, py::arg("coarse_points") = 64,
+           py::arg("refine_points") = 512, py::arg("coarse_trim") = 0.0,
+           py::arg("pca_starts") = true, py::arg("rotation_starts") = 24,
+           py::arg("refine_best") = 2, py::arg("exact_models") = 3,
+           py::arg("hopeless_factor") = 3.0, py::arg("field_cell") = 2e-3,
+           py::arg("score_gate") = 0.01, py::arg("unknown_score") = 3e-3)
+      .def(
+          "add",
+          [](reg::ObjectLibrary<double>& lib, std::string name, const ArrayD& points,
+             const std::optional<ArrayD>& normals, int normal_neighbors) {
+            reg::TargetConfig t;
+            t.normal_neighbors = normal_neighbors;
+            Cloud c = cloud_from(points, normals, "points");
+            py::gil_scoped_release release;
+            lib.add(std::move(name), std::move(c), t);
+          },
+          py::arg("name"), py::arg("points"), py::arg("normals") = py::none(), py::kw_only(),
+          py::arg("normal_neighbors") = 12, "Adds a model: (N, 3) points [m], optional normals.")
+      .def("__len__", &reg::ObjectLibrary<double>::size)
+      .def_property_readonly("names",
+                             [](const reg::ObjectLibrary<double>& lib) {
+                               std::vector<std::string> out;
+                               for (std::size_t i = 0; i < lib.size(); ++i) out.push_back(lib.name(i));
+                               return out;
+                             })
+      .def(
+          "recognize",
+          [](const reg::ObjectLibrary<double>& lib, const ArrayD& points) {
+            Cloud c = cloud_from(points, std::nullopt, "points");
+            py::gil_scoped_release release;
+            return lib.recognize(c);
+          },
+          py::arg("points"),
+          "Ranks the models for a cloud of (N, 3) points [m]; the GIL is released, so threads "
+          "may recognise at once.");
+}
+
+}  // namespace taxel::python
