@@ -1,4 +1,433 @@
+// SPDX-License-Identifier: MIT
+// taxel.image: k-means, segmentation, components, region properties, gradients,
+// reconstruction and the recogniser, on 2-D images and 3-D stacks of frames.
+#include <span>
+
 #include "common.hpp"
+#include "taxel/image.hpp"
+
 namespace taxel::python {
-void bind_image(py::module_& m) { m.def_submodule("image"); }
+namespace {
+
+namespace im = taxel::image;
+
+using ImageMap = Eigen::Map<const im::ImageD>;
+using MaskMap = Eigen::Map<const im::Mask>;
+
+constexpr std::pair<std::string_view, im::Polarity> kPolarities[] = {
+    {"high_is_pressure", im::Polarity::high_is_pressure},
+    {"dark_is_pressure", im::Polarity::dark_is_pressure}};
+constexpr std::pair<std::string_view, im::PostProcess> kPost[] = {
+    {"none", im::PostProcess::none},
+    {"mean3x3", im::PostProcess::mean3x3},
+    {"median3x3", im::PostProcess::median3x3}};
+constexpr std::pair<std::string_view, im::Healing> kHealing[] = {
+    {"linear", im::Healing::linear}, {"row_mean", im::Healing::row_mean}, {"none", im::Healing::none}};
+constexpr std::pair<std::string_view, im::HeightSource> kSources[] = {
+    {"raw", im::HeightSource::raw}, {"quantised", im::HeightSource::quantised}};
+constexpr std::pair<std::string_view, im::GradientSource> kGradientSources[] = {
+    {"raw", im::GradientSource::raw}, {"quantised", im::GradientSource::quantised}};
+
+im::Connectivity connectivity_from(int c) {
+  if (c != 4 && c != 8) {
+    throw py::value_error("connectivity must be 4 or 8, got " + std::to_string(c));
+  }
+  return c == 4 ? im::Connectivity::four : im::Connectivity::eight;
 }
+
+/// Frame count, rows and columns of a 2-D image or a 3-D stack.
+struct Frames {
+  py::ssize_t frames, rows, cols;
+  bool stacked;
+};
+
+Frames frames_of(const py::array& a, const char* what) {
+  if (a.ndim() == 2) return {1, a.shape(0), a.shape(1), false};
+  if (a.ndim() == 3) return {a.shape(0), a.shape(1), a.shape(2), true};
+  throw py::value_error(std::string(what) +
+                        ": expected an image (rows, cols) or a stack (frames, rows, cols), got " +
+                        shape_text(a));
+}
+
+ImageMap frame(const ArrayD& a, const Frames& f, py::ssize_t i) {
+  return {a.data() + i * f.rows * f.cols, f.rows, f.cols};
+}
+
+/// A stack of `f.frames` images of f.rows x f.cols (2-D when the input was 2-D).
+template <class T>
+py::array_t<T> stack_like(const Frames& f) {
+  if (!f.stacked) return py::array_t<T>({f.rows, f.cols});
+  return py::array_t<T>({f.frames, f.rows, f.cols});
+}
+
+py::dict props_dict(const im::RegionProps& p) {
+  py::dict d;
+  d["area"] = p.area;
+  d["centroid"] = py::make_tuple(p.centroid.x(), p.centroid.y());
+  d["bounding_box"] =
+      py::make_tuple(p.bounding_box(0), p.bounding_box(1), p.bounding_box(2), p.bounding_box(3));
+  d["major_axis_length"] = p.major_axis;
+  d["minor_axis_length"] = p.minor_axis;
+  d["eccentricity"] = p.eccentricity;
+  d["orientation"] = p.orientation;
+  d["convex_area"] = p.convex_area;
+  ArrayD hull({static_cast<py::ssize_t>(p.convex_hull.size()), py::ssize_t{2}});
+  for (std::size_t i = 0; i < p.convex_hull.size(); ++i) {
+    hull.mutable_data()[2 * i] = p.convex_hull[i].x();
+    hull.mutable_data()[2 * i + 1] = p.convex_hull[i].y();
+  }
+  d["convex_hull"] = hull;
+  d["solidity"] = p.solidity;
+  d["extent"] = p.extent;
+  d["equiv_diameter"] = p.equiv_diameter;
+  d["euler_number"] = p.euler_number;
+  d["euler_number4"] = p.euler_number4;
+  d["perimeter"] = p.perimeter;
+  return d;
+}
+
+im::SegmentationConfig segmentation_config(int k, const std::string& polarity, int min_area,
+                                           int connectivity, int histogram_levels) {
+  return {k, enum_from(polarity, kPolarities, "polarity"), min_area,
+          connectivity_from(connectivity), histogram_levels};
+}
+
+/// The Python Recognizer: the paper's chain with the gradient-threshold edge rule.
+struct PyRecognizer {
+  im::Recognizer<> recognizer;
+};
+
+}  // namespace
+
+void bind_image(py::module_& root) {
+  py::module_ m = root.def_submodule("image", R"doc(
+Pressure images: 1-D k-means segmentation, high-pressure regions (HPR), region descriptors,
+gradients, RecEdged / RecEdgeless reconstruction and the recogniser. Images are (rows, cols)
+float arrays, row 0 at the top; stacks are (frames, rows, cols). Region descriptors follow
+MATLAB's regionprops: 1-based (x, y) = (column, row) pixel coordinates, orientation in degrees
+counter-clockwise with y up.)doc");
+  m.attr("REGIONAL_FEATURE_NAMES") =
+      std::vector<std::string>(im::kRegionalFeatureNames.begin(), im::kRegionalFeatureNames.end());
+  m.attr("EDGE_FEATURE_NAMES") =
+      std::vector<std::string>(im::kEdgeFeatureNames.begin(), im::kEdgeFeatureNames.end());
+
+  py::class_<im::KMeans1dResult>(m, "KMeans1dResult", "A 1-D clustering, clusters ascending.")
+      .def_property_readonly("status",
+                             [](const im::KMeans1dResult& r) { return std::string(to_string(r.status)); })
+      .def_readonly("message", &im::KMeans1dResult::message)
+      .def_readonly("k", &im::KMeans1dResult::k, "clusters found: min(k_requested, distinct values)")
+      .def_readonly("k_requested", &im::KMeans1dResult::k_requested)
+      .def_readonly("centroids", &im::KMeans1dResult::centroids)
+      .def_readonly("lower", &im::KMeans1dResult::lower, "smallest value of each cluster")
+      .def_readonly("upper", &im::KMeans1dResult::upper, "largest value of each cluster")
+      .def_readonly("sizes", &im::KMeans1dResult::sizes)
+      .def_readonly("sse", &im::KMeans1dResult::sse, "within-cluster sum of squared deviations")
+      .def_readonly("iterations", &im::KMeans1dResult::iterations)
+      .def(
+          "labels",
+          [](const im::KMeans1dResult& r, const ArrayD& values) {
+            py::array_t<int> out(values.size());
+            for (py::ssize_t i = 0; i < values.size(); ++i) {
+              out.mutable_data()[i] = r.cluster_of(values.data()[i]);
+            }
+            return out;
+          },
+          py::arg("values"), "the cluster of each value (flattened)");
+
+  m.def(
+      "kmeans1d",
+      [](const ArrayD& values, int k, const std::string& method, std::uint64_t seed,
+         int max_iterations) {
+        const std::span<const double> v(values.data(), static_cast<std::size_t>(values.size()));
+        im::KMeans1dResult r;
+        if (method == "exact") {
+          py::gil_scoped_release release;
+          r = im::kmeans1d(v, k);
+        } else if (method == "lloyd") {
+          py::gil_scoped_release release;
+          r = im::kmeans1d_lloyd(v, {k, seed, max_iterations});
+        } else {
+          throw py::value_error("kmeans1d: method must be 'exact' or 'lloyd', got '" + method + "'");
+        }
+        raise_unless_ok(r, true);
+        return r;
+      },
+      py::arg("values"), py::arg("k") = 3, py::kw_only(), py::arg("method") = "exact",
+      py::arg("seed") = 1, py::arg("max_iterations") = 100,
+      "k-means of the (flattened) values: 'exact' (globally optimal, dynamic programming) or "
+      "'lloyd' (k-means++ start). Raises ValueError for empty or non-finite values.");
+
+  py::class_<im::Segmentation>(m, "Segmentation", "The segmentation of one image.")
+      .def_property_readonly("classes", [](const im::Segmentation& s) { return s.classes; },
+                             "uint8 class per pixel: 0 background .. k-1 high pressure")
+      .def_property_readonly("quantised", [](const im::Segmentation& s) { return s.quantised; },
+                             "each pixel replaced by its cluster's centroid")
+      .def_property_readonly("high", [](const im::Segmentation& s) { return s.high; },
+                             "uint8 mask of the HPR pixels after removal of small regions")
+      .def_property_readonly("high_raw", [](const im::Segmentation& s) { return s.high_raw; })
+      .def_readonly("kmeans", &im::Segmentation::kmeans)
+      .def_readonly("regions", &im::Segmentation::regions, "HPR components kept")
+      .def_readonly("background_level", &im::Segmentation::background_level)
+      .def_readonly("high_level", &im::Segmentation::high_level)
+      .def_readonly("pixel_min", &im::Segmentation::pixel_min)
+      .def_readonly("pixel_max", &im::Segmentation::pixel_max)
+      .def_readonly("pixel_mean", &im::Segmentation::pixel_mean);
+
+  m.def(
+      "segment",
+      [](const ArrayD& image, int k, const std::string& polarity, int min_area, int connectivity,
+         int histogram_levels) -> py::object {
+        const Frames f = frames_of(image, "segment");
+        im::Segmenter seg(segmentation_config(k, polarity, min_area, connectivity, histogram_levels),
+                          f.rows, f.cols);
+        std::vector<im::Segmentation> out;
+        for (py::ssize_t i = 0; i < f.frames; ++i) {
+          {
+            py::gil_scoped_release release;
+            out.push_back(seg.run(frame(image, f, i)));
+          }
+          if (!out.back().ok()) {
+            throw py::value_error((f.stacked ? "frame " + std::to_string(i) + ": " : "") +
+                                  out.back().message);
+          }
+        }
+        if (!f.stacked) return py::cast(std::move(out.front()));
+        return py::cast(std::move(out));
+      },
+      py::arg("image"), py::kw_only(), py::arg("k") = 3, py::arg("polarity") = "high_is_pressure",
+      py::arg("min_area") = 50, py::arg("connectivity") = 8, py::arg("histogram_levels") = 65536,
+      "Segments an image (a Segmentation) or a stack (a list): k-means of the pixel values, "
+      "the top cluster's 8-connected regions of at least min_area pixels are the HPR.");
+
+  m.def(
+      "label",
+      [](const ArrayU8& mask, int connectivity) {
+        require_shape(mask, {-1, -1}, "label", "(rows, cols)");
+        im::Components comp(mask.shape(0), mask.shape(1));
+        const int n = comp.compute(MaskMap(mask.data(), mask.shape(0), mask.shape(1)),
+                                   connectivity_from(connectivity));
+        return py::make_tuple(im::Labels(comp.labels()), n);
+      },
+      py::arg("mask"), py::arg("connectivity") = 8,
+      "(labels, count): connected components of the non-zero pixels, numbered from 1 in raster "
+      "order (MATLAB's bwlabel numbers in column order).");
+
+  m.def(
+      "region_props",
+      [](const ArrayU8& mask, bool zero_based, bool convex, bool perimeter) {
+        require_shape(mask, {-1, -1}, "region_props", "(rows, cols)");
+        im::RegionProps p;
+        {
+          py::gil_scoped_release release;
+          p = im::region_props(MaskMap(mask.data(), mask.shape(0), mask.shape(1)),
+                               {zero_based, convex, perimeter});
+        }
+        return props_dict(p);
+      },
+      py::arg("mask"), py::kw_only(), py::arg("zero_based") = false, py::arg("convex") = true,
+      py::arg("perimeter") = true,
+      "Descriptors of the non-zero pixels of `mask` as one region (MATLAB's regionprops of a "
+      "logical image): area, centroid (x, y), bounding_box (ulx, uly, width, height) on pixel "
+      "edges, major/minor_axis_length, eccentricity, orientation [deg], convex_area, "
+      "convex_hull (K, 2) (x, y), solidity, extent, equiv_diameter, euler_number (8-connected "
+      "objects), euler_number4, perimeter. Coordinates are 1-based unless zero_based.");
+
+  m.def(
+      "regionprops",
+      [](const ArrayI& labels, bool zero_based, bool convex, bool perimeter) {
+        require_shape(labels, {-1, -1}, "regionprops", "(rows, cols)");
+        const py::ssize_t rows = labels.shape(0), cols = labels.shape(1);
+        int top = 0;
+        for (py::ssize_t i = 0; i < labels.size(); ++i) {
+          if (labels.data()[i] < 0) throw py::value_error("regionprops: negative label");
+          top = std::max(top, labels.data()[i]);
+        }
+        im::RegionAnalyzer analyzer({zero_based, convex, perimeter}, rows, cols);
+        im::Mask mask(rows, cols);
+        py::list out;
+        for (int id = 1; id <= top; ++id) {
+          bool any = false;
+          for (py::ssize_t i = 0; i < labels.size(); ++i) {
+            mask.data()[i] = labels.data()[i] == id ? 1 : 0;
+            any = any || mask.data()[i];
+          }
+          if (!any) continue;
+          py::dict d = props_dict(analyzer.compute(mask));
+          d["label"] = id;
+          out.append(d);
+        }
+        return out;
+      },
+      py::arg("labels"), py::kw_only(), py::arg("zero_based") = false, py::arg("convex") = true,
+      py::arg("perimeter") = true,
+      "A dict of descriptors (see region_props) per label 1..max of a label image, with its "
+      "'label'; absent labels are skipped.");
+
+  m.def(
+      "gradient",
+      [](const ArrayD& image) {
+        const Frames f = frames_of(image, "gradient");
+        auto mag = stack_like<double>(f);
+        auto dir = stack_like<double>(f);
+        py::gil_scoped_release release;
+        im::ImageD a, b, gx, gy;
+        for (py::ssize_t i = 0; i < f.frames; ++i) {
+          im::gradient(frame(image, f, i), a, b, gx, gy);
+          std::copy(a.data(), a.data() + a.size(), mag.mutable_data() + i * a.size());
+          std::copy(b.data(), b.data() + b.size(), dir.mutable_data() + i * b.size());
+        }
+        py::gil_scoped_acquire acquire;
+        return py::make_tuple(mag, dir);
+      },
+      py::arg("image"),
+      "(magnitude, direction): MATLAB's imgradient with Sobel kernels and replicated borders; "
+      "direction in degrees in (-180, 180], counter-clockwise from +x with y up.");
+
+  m.def(
+      "sobel",
+      [](const ArrayD& image) {
+        const Frames f = frames_of(image, "sobel");
+        auto ox = stack_like<double>(f);
+        auto oy = stack_like<double>(f);
+        py::gil_scoped_release release;
+        im::ImageD gx, gy;
+        for (py::ssize_t i = 0; i < f.frames; ++i) {
+          im::sobel(frame(image, f, i), gx, gy);
+          std::copy(gx.data(), gx.data() + gx.size(), ox.mutable_data() + i * gx.size());
+          std::copy(gy.data(), gy.data() + gy.size(), oy.mutable_data() + i * gy.size());
+        }
+        py::gil_scoped_acquire acquire;
+        return py::make_tuple(ox, oy);
+      },
+      py::arg("image"), "(gx, gy): MATLAB's imgradientxy (Sobel), y pointing up.");
+
+  m.def(
+      "contour",
+      [](const ArrayU8& mask) {
+        require_shape(mask, {-1, -1}, "contour", "(rows, cols)");
+        im::Mask out;
+        im::contour(MaskMap(mask.data(), mask.shape(0), mask.shape(1)), out);
+        return out;
+      },
+      py::arg("mask"), "The contour pixels of a region (MATLAB's bwperim, 4-connected).");
+
+  m.def(
+      "rec_edged",
+      [](const im::Segmentation& seg, double k, double background_fraction,
+         bool swap_edge_condition, bool fill_whole_row, bool keep_level_on_skipped_rows,
+         const std::string& postprocess) {
+        const im::RecEdgedConfig cfg{k,
+                                     background_fraction,
+                                     swap_edge_condition,
+                                     fill_whole_row,
+                                     keep_level_on_skipped_rows,
+                                     enum_from(postprocess, kPost, "postprocess")};
+        im::Reconstructor rec(cfg, {}, seg.classes.rows(), seg.classes.cols());
+        return im::ImageD(rec.rec_edged(seg));
+      },
+      py::arg("segmentation"), py::kw_only(), py::arg("k") = 0.5,
+      py::arg("background_fraction") = 0.5, py::arg("swap_edge_condition") = false,
+      py::arg("fill_whole_row") = false, py::arg("keep_level_on_skipped_rows") = false,
+      py::arg("postprocess") = "none",
+      "RecEdged: a height map from a segmentation by a row-scanning two-state machine; steps of "
+      "k * high_level.");
+
+  m.def(
+      "rec_edgeless",
+      [](const ArrayD& image, const im::Segmentation& seg, double background_fraction, int degree,
+         const std::string& healing, const std::string& source) {
+        require_shape(image, {seg.classes.rows(), seg.classes.cols()}, "rec_edgeless",
+                      "(rows, cols) like the segmentation");
+        const im::RecEdgelessConfig cfg{background_fraction, degree,
+                                        enum_from(healing, kHealing, "healing"),
+                                        enum_from(source, kSources, "source")};
+        im::Reconstructor rec({}, cfg, seg.classes.rows(), seg.classes.cols());
+        return im::ImageD(
+            rec.rec_edgeless(ImageMap(image.data(), image.shape(0), image.shape(1)), seg));
+      },
+      py::arg("image"), py::arg("segmentation"), py::kw_only(),
+      py::arg("background_fraction") = 0.5, py::arg("degree") = 2, py::arg("healing") = "linear",
+      py::arg("source") = "raw",
+      "RecEdgeless: a height map from the image, gaps healed within rows and every column "
+      "replaced by its least-squares polynomial of `degree`.");
+
+  py::class_<im::Recognition>(m, "Recognition", "The recogniser's result for one image.")
+      .def_readonly("edged", &im::Recognition::edged)
+      .def_readonly("contour_gradient", &im::Recognition::contour_gradient,
+                    "mean contour gradient magnitude of the largest HPR (feature 18)")
+      .def_readonly("regional", &im::Recognition::regional, "the 11 regional features")
+      .def_readonly("edge_features", &im::Recognition::edge_features, "the 23 edge features")
+      .def_readonly("hybrid", &im::Recognition::hybrid,
+                    "rows*cols gradient magnitudes (row-major) followed by the 11 regional features");
+
+  py::class_<PyRecognizer>(m, "Recognizer", R"doc(
+The second paper's chain for images of rows x cols: segmentation, HPR descriptors, contour
+gradients, the edged/edgeless decision (mean contour gradient of the largest HPR above
+gradient_threshold) and the feature vectors.)doc")
+      .def(py::init([](py::ssize_t rows, py::ssize_t cols, double gradient_threshold,
+                       const std::string& gradient_source, int k, const std::string& polarity,
+                       int min_area, int connectivity) {
+             im::RecognizerConfig cfg;
+             cfg.segmentation = segmentation_config(k, polarity, min_area, connectivity, 65536);
+             cfg.gradient_source = enum_from(gradient_source, kGradientSources, "gradient_source");
+             return PyRecognizer{im::Recognizer<>(rows, cols, cfg, im::GradientThreshold{gradient_threshold})};
+           }),
+           py::arg("rows") = 32, py::arg("cols") = 32, py::kw_only(),
+           py::arg("gradient_threshold") = 25.0, py::arg("gradient_source") = "raw",
+           py::arg("k") = 3, py::arg("polarity") = "high_is_pressure", py::arg("min_area") = 50,
+           py::arg("connectivity") = 8)
+      .def(
+          "recognize",
+          [](PyRecognizer& r, const ArrayD& image) {
+            require_shape(image, {-1, -1}, "recognize", "(rows, cols)");
+            im::Recognition out;
+            {
+              py::gil_scoped_release release;
+              out = r.recognizer.recognize(ImageMap(image.data(), image.shape(0), image.shape(1)));
+            }
+            raise_unless_ok(out);
+            return out;
+          },
+          py::arg("image"), "Runs the chain on one image; ValueError for a wrong size or NaN.")
+      .def(
+          "features",
+          [](PyRecognizer& r, const ArrayD& images) {
+            const Frames f = frames_of(images, "features");
+            const auto n = f.frames;
+            ArrayD regional({n, py::ssize_t{im::kRegionalFeatures}});
+            ArrayD edge({n, py::ssize_t{im::kEdgeFeatures}});
+            ArrayD hybrid({n, f.rows * f.cols + im::kRegionalFeatures});
+            py::array_t<bool> edged(n);
+            ArrayD gm(n);
+            std::string error;
+            {
+              py::gil_scoped_release release;
+              for (py::ssize_t i = 0; i < n && error.empty(); ++i) {
+                const im::Recognition& x = r.recognizer.recognize(frame(images, f, i));
+                if (!x.ok()) {
+                  error = "frame " + std::to_string(i) + ": " + x.message;
+                  break;
+                }
+                std::copy_n(x.regional.data(), x.regional.size(), regional.mutable_data() + i * x.regional.size());
+                std::copy_n(x.edge_features.data(), x.edge_features.size(),
+                            edge.mutable_data() + i * x.edge_features.size());
+                std::copy_n(x.hybrid.data(), x.hybrid.size(), hybrid.mutable_data() + i * x.hybrid.size());
+                edged.mutable_data()[i] = x.edged;
+                gm.mutable_data()[i] = x.contour_gradient;
+              }
+            }
+            if (!error.empty()) throw py::value_error(error);
+            py::dict d;
+            d["regional"] = regional;
+            d["edge"] = edge;
+            d["hybrid"] = hybrid;
+            d["edged"] = edged;
+            d["contour_gradient"] = gm;
+            return d;
+          },
+          py::arg("images"),
+          "Features of an image or a stack: a dict of 'regional' (F, 11), 'edge' (F, 23), "
+          "'hybrid' (F, rows*cols + 11), 'edged' (F,) and 'contour_gradient' (F,).");
+}
+
+}  // namespace taxel::python
