@@ -299,7 +299,9 @@ counter-clockwise with y up.)doc");
         py::gil_scoped_acquire acquire;
         return py::make_tuple(ox, oy);
       },
-      py::arg("image"), "(gx, gy): MATLAB's imgradientxy (Sobel), y pointing up.");
+      py::arg("image"),
+      "(gx, gy): Sobel derivatives with replicated borders as MATLAB's imgradientxy; gx grows "
+      "to the right, gy towards larger row indices (down).");
 
   m.def(
       "contour",
