@@ -133,7 +133,7 @@ Simulation: analytic shapes and triangle meshes (metres, centred at the origin),
 sampling, tactile explorations with a pad of the sensor model, surface errors, and the
 palm-grasp pressure-image synthesiser.)doc");
 
-  py::class_<sm::Sphere> sphere(m, "Sphere");
+  py::class_<sm::Sphere> sphere(m, "Sphere", "Sphere of `radius` [m] centred at the origin.");
   sphere.def(py::init<double>(), py::arg("radius") = 0.04).def_readonly("radius", &sm::Sphere::radius);
   shape_methods(sphere);
   py::class_<sm::Cylinder> cylinder(m, "Cylinder", "Capped cylinder along z.");
@@ -141,7 +141,7 @@ palm-grasp pressure-image synthesiser.)doc");
       .def_readonly("radius", &sm::Cylinder::radius)
       .def_readonly("half_height", &sm::Cylinder::half_height);
   shape_methods(cylinder);
-  py::class_<sm::Box> box(m, "Box");
+  py::class_<sm::Box> box(m, "Box", "Box of `half_extents` [m] centred at the origin, axis-aligned.");
   box.def(py::init([](const Eigen::Vector3d& h) { return sm::Box(h); }),
           py::arg("half_extents") = Eigen::Vector3d(0.04, 0.03, 0.02))
       .def_readonly("half_extents", &sm::Box::half_extents);
@@ -151,7 +151,7 @@ palm-grasp pressure-image synthesiser.)doc");
       .def_readonly("radius", &sm::Cone::radius)
       .def_readonly("height", &sm::Cone::height);
   shape_methods(cone);
-  py::class_<sm::Ellipsoid> ellipsoid(m, "Ellipsoid");
+  py::class_<sm::Ellipsoid> ellipsoid(m, "Ellipsoid", "Ellipsoid of `semi_axes` [m] along x, y, z.");
   ellipsoid.def(py::init([](const Eigen::Vector3d& e) { return sm::Ellipsoid(e); }),
                 py::arg("semi_axes") = Eigen::Vector3d(0.05, 0.035, 0.025))
       .def_readonly("semi_axes", &sm::Ellipsoid::semi_axes);
@@ -182,8 +182,9 @@ palm-grasp pressure-image synthesiser.)doc");
   shape_methods(mesh);
   m.def("icosphere", &sm::icosphere, py::arg("radius"), py::arg("subdivisions"),
         "A sphere mesh: an icosahedron subdivided `subdivisions` times, vertices on the sphere.");
-  m.def("box_mesh", &sm::box_mesh, py::arg("box"));
-  m.def("cylinder_mesh", &sm::cylinder_mesh, py::arg("cylinder"), py::arg("segments"));
+  m.def("box_mesh", &sm::box_mesh, py::arg("box"), "The box as a mesh of 12 triangles.");
+  m.def("cylinder_mesh", &sm::cylinder_mesh, py::arg("cylinder"), py::arg("segments"),
+        "The capped cylinder as a mesh with `segments` sides.");
 
   m.def(
       "surface_error",

@@ -109,4 +109,4 @@ def regionprops(labels: numpy.typing.NDArray[numpy.int32], *, zero_based: bool =
 
 def segment(image: numpy.typing.NDArray[numpy.float64], *, k: int = 3, polarity: str = 'high_is_pressure', min_area: int = 50, connectivity: int = 8, histogram_levels: int = 65536) -> typing.Union[taxel.image.Segmentation, typing.List[taxel.image.Segmentation]]: """Segments an image (a Segmentation) or a stack (a list): k-means of the pixel values, the top cluster's 8-connected regions of at least min_area pixels are the HPR."""
 
-def sobel(image: numpy.typing.NDArray[numpy.float64]) -> tuple: """(gx, gy): MATLAB's imgradientxy (Sobel), y pointing up."""
+def sobel(image: numpy.typing.NDArray[numpy.float64]) -> tuple: """(gx, gy): Sobel derivatives with replicated borders as MATLAB's imgradientxy; gx grows to the right, gy towards larger row indices (down)."""
