@@ -17,6 +17,7 @@ import taxel.sim
 
 
 class Box:
+    """Box of `half_extents` [m] centred at the origin, axis-aligned."""
     def __init__(self, half_extents: numpy.typing.NDArray[numpy.float64] = ...) -> None: ...
     def closest_point(self, points: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(N, 3) closest surface points"""
     @property
@@ -59,6 +60,7 @@ class Cylinder:
 
 
 class Ellipsoid:
+    """Ellipsoid of `semi_axes` [m] along x, y, z."""
     def __init__(self, semi_axes: numpy.typing.NDArray[numpy.float64] = ...) -> None: ...
     def closest_point(self, points: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(N, 3) closest surface points"""
     def normal(self, points: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(N, 3) outward unit normals at the closest surface points"""
@@ -92,6 +94,7 @@ class PalmGraspSynth:
 
 
 class Sphere:
+    """Sphere of `radius` [m] centred at the origin."""
     def __init__(self, radius: float = 0.04) -> None: ...
     def closest_point(self, points: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(N, 3) closest surface points"""
     def normal(self, points: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(N, 3) outward unit normals at the closest surface points"""
@@ -128,9 +131,9 @@ class TriangleMesh:
     def signed_distance(self, points: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(N,) signed distances [m] of (N, 3) points, outside positive"""
     def surface_area(self) -> float: """[m^2]"""
 
-def box_mesh(box: taxel.sim.Box) -> taxel.sim.TriangleMesh: ...
+def box_mesh(box: taxel.sim.Box) -> taxel.sim.TriangleMesh: """The box as a mesh of 12 triangles."""
 
-def cylinder_mesh(cylinder: taxel.sim.Cylinder, segments: int) -> taxel.sim.TriangleMesh: ...
+def cylinder_mesh(cylinder: taxel.sim.Cylinder, segments: int) -> taxel.sim.TriangleMesh: """The capped cylinder as a mesh with `segments` sides."""
 
 def explore_grasps(shape: object, *, grasps: int = 8, fingers: int = 3, pads_per_finger: int = 2, pad_spacing: float = 0.05, closing_speed: float = 0.05, hold_frames: int = 50, sensor: taxel.sensor.SensorModel = ..., contacts: taxel.sensor.ContactOptions = ..., frame_rate: float = 1000.0, indentation: float = 0.001, object_pose: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, seed: int = 1) -> taxel.sim.Exploration: """Closes a hand of fingers x pads_per_finger pads on the shape `grasps` times."""
 
