@@ -1,19 +1,23 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Installs the Debian 12 packages taxel needs when they are missing.
-# Usage: scripts/install-deps.sh [build|test|bench|demo|fuzz|all]   (default: test)
+# Usage: scripts/install-deps.sh [build|test|bench|demo|fuzz|python|all]   (default: test)
 set -euo pipefail
 
 what=${1:-test}
 pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev)
+# The Python module, and what its tests and examples compare with or plot through.
+python=(pybind11-dev python3-dev python3-numpy python3-venv python3-setuptools python3-pip)
+python_test=(python3-pytest python3-scipy python3-skimage python3-matplotlib)
 case "$what" in
   build) ;;
-  test) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium) ;;
+  test) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium "${python[@]}" "${python_test[@]}") ;;
   bench) pkgs+=(libbenchmark-dev libpng-dev liblinear-dev) ;;
   demo) pkgs+=(libpng-dev libusb-1.0-0-dev) ;;
   fuzz) pkgs+=(catch2 clang libclang-rt-14-dev) ;;
-  all) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium clang libclang-rt-14-dev) ;;
-  *) echo "install-deps.sh: unknown set '$what' (build|test|bench|demo|fuzz|all)" >&2; exit 2 ;;
+  python) pkgs+=("${python[@]}") ;;
+  all) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium clang libclang-rt-14-dev "${python[@]}" "${python_test[@]}") ;;
+  *) echo "install-deps.sh: unknown set '$what' (build|test|bench|demo|fuzz|python|all)" >&2; exit 2 ;;
 esac
 
 missing=()

@@ -106,8 +106,7 @@ inline Isometry3d pose_from(const ArrayD& a, const char* what) {
     throw py::value_error(who + ": the last row must be (0, 0, 0, 1)");
   }
   const Mat3d r = m.topLeftCorner<3, 3>();
-  if ((r.transpose() * r - Mat3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
-      r.determinant() < 0) {
+  if ((r.transpose() * r - Mat3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || r.determinant() < 0) {
     throw py::value_error(who + ": the upper-left 3x3 block is not a rotation");
   }
   Isometry3d t = Isometry3d::Identity();
@@ -210,7 +209,8 @@ struct ContactRows {
     }
     if (normals) {
       const double* q = normals->data() + 3 * i;
-      if (!(std::isnan(q[0]) && std::isnan(q[1]) && std::isnan(q[2]))) c.normal = Vec3d(q[0], q[1], q[2]);
+      if (!(std::isnan(q[0]) && std::isnan(q[1]) && std::isnan(q[2])))
+        c.normal = Vec3d(q[0], q[1], q[2]);
     }
     if (pressures) c.pressure = pressures->data()[i];
     if (times) c.time = times->data()[i];

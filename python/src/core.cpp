@@ -148,7 +148,8 @@ the C++ loop with no conversion.)doc")
             ArrayD out({static_cast<py::ssize_t>(cs.size()), py::ssize_t{3}});
             double* p = out.mutable_data();
             for (const auto& c : cs) {
-              store(p, c.normal ? *c.normal : Vec3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+              store(p, c.normal ? *c.normal
+                                : Vec3d::Constant(std::numeric_limits<double>::quiet_NaN()));
               p += 3;
             }
             return out;

@@ -161,7 +161,8 @@ void check_unused(const CloudOptions& o, int policy, int index) {
   };
   const bool kalman_like = policy == 0 || policy == 1;
   if (!kalman_like) {
-    if (o.process_noise != d.process_noise) refuse("process_noise", "the surfel and kalman policies");
+    if (o.process_noise != d.process_noise)
+      refuse("process_noise", "the surfel and kalman policies");
     if (o.gate_chi2) refuse("gate_chi2", "the surfel and kalman policies");
     if (o.initial_sigma) refuse("initial_sigma", "the surfel and kalman policies");
   }
@@ -243,7 +244,9 @@ ContactList readings_to_contacts(const ArrayU16& readings, const ArrayD& poses,
       pose.pad = p;
       if (times) pose.time = times->data()[f];
       const ArrayD one({4, 4}, m);
-      pose.pose = pose_from(one, ("poses[" + std::to_string(f) + (one_pad ? "" : ", " + std::to_string(p)) + "]").c_str());
+      pose.pose = pose_from(
+          one,
+          ("poses[" + std::to_string(f) + (one_pad ? "" : ", " + std::to_string(p)) + "]").c_str());
       list.push_back(pose);
     }
   }
@@ -257,7 +260,8 @@ ContactList readings_to_contacts(const ArrayU16& readings, const ArrayD& poses,
 
 void bind_fusion(py::module_& root) {
   // ---- taxel.sensor ---------------------------------------------------------------------------
-  py::module_ s = root.def_submodule("sensor", "Tactile pads: sensor model and readings to contacts");
+  py::module_ s =
+      root.def_submodule("sensor", "Tactile pads: sensor model and readings to contacts");
   py::class_<sensor::SensorModel>(s, "SensorModel", R"doc(
 How a pad of rows x cols tactels at `pitch` [m] turns indentation into readings: a tactel
 pressed d [m] reads d / full_scale_depth * (levels - 1) counts plus Gaussian depth noise of
@@ -279,9 +283,9 @@ sigma_tilt [rad] are the per-frame noise of the pad pose. Defaults: a Weiss DSA 
              return m;
            }),
            py::arg("rows") = 14, py::arg("cols") = 6, py::arg("pitch") = 3.4e-3,
-           py::arg("full_scale_depth") = 3e-3, py::arg("levels") = 4096,
-           py::arg("threshold") = 8, py::arg("sigma_normal") = 0.3e-3,
-           py::arg("sigma_position") = 0.2e-3, py::arg("sigma_tilt") = 0.02)
+           py::arg("full_scale_depth") = 3e-3, py::arg("levels") = 4096, py::arg("threshold") = 8,
+           py::arg("sigma_normal") = 0.3e-3, py::arg("sigma_position") = 0.2e-3,
+           py::arg("sigma_tilt") = 0.02)
       .def_property_readonly("rows", [](const sensor::SensorModel& m) { return m.geometry.rows; })
       .def_property_readonly("cols", [](const sensor::SensorModel& m) { return m.geometry.cols; })
       .def_property_readonly("pitch", [](const sensor::SensorModel& m) { return m.geometry.pitch; })
@@ -292,16 +296,17 @@ sigma_tilt [rad] are the per-frame noise of the pad pose. Defaults: a Weiss DSA 
       .def_readonly("sigma_position", &sensor::SensorModel::sigma_position)
       .def_readonly("sigma_tilt", &sensor::SensorModel::sigma_tilt)
       .def("depth_per_count", &sensor::SensorModel::depth_per_count, "depth of one count [m]")
-      .def("tactel",
-           [](const sensor::SensorModel& m, int r, int c) {
-             const Vec3d p = m.geometry.tactel(r, c);
-             return std::vector<double>{p.x(), p.y(), p.z()};
-           },
-           py::arg("row"), py::arg("col"), "centre of tactel (row, col) in the pad frame [m]")
+      .def(
+          "tactel",
+          [](const sensor::SensorModel& m, int r, int c) {
+            const Vec3d p = m.geometry.tactel(r, c);
+            return std::vector<double>{p.x(), p.y(), p.z()};
+          },
+          py::arg("row"), py::arg("col"), "centre of tactel (row, col) in the pad frame [m]")
       .def("__repr__", [](const sensor::SensorModel& m) {
         return "SensorModel(rows=" + std::to_string(m.geometry.rows) +
-               ", cols=" + std::to_string(m.geometry.cols) + ", pitch=" +
-               std::to_string(m.geometry.pitch) + ")";
+               ", cols=" + std::to_string(m.geometry.cols) +
+               ", pitch=" + std::to_string(m.geometry.pitch) + ")";
       });
 
   py::class_<sensor::ContactOptions>(s, "ContactOptions", R"doc(
@@ -321,16 +326,15 @@ How readings become contacts: `mode` 'per_tactel' (a contact per active tactel) 
            }),
            py::arg("mode") = "per_tactel", py::arg("local_normals") = true,
            py::arg("correct_censoring") = true, py::arg("fallback_normal_sigma") = 0.15)
-      .def_property_readonly("mode",
-                             [](const sensor::ContactOptions& o) { return enum_name(o.mode, kModes); })
+      .def_property_readonly(
+          "mode", [](const sensor::ContactOptions& o) { return enum_name(o.mode, kModes); })
       .def_readonly("local_normals", &sensor::ContactOptions::local_normals)
       .def_readonly("correct_censoring", &sensor::ContactOptions::correct_censoring)
       .def_readonly("fallback_normal_sigma", &sensor::ContactOptions::fallback_normal_sigma);
 
   s.def("contacts_from_readings", &readings_to_contacts, py::arg("readings"), py::arg("poses"),
-        py::kw_only(), py::arg("times") = py::none(),
-        py::arg("model") = sensor::SensorModel{}, py::arg("options") = sensor::ContactOptions{},
-        py::arg("frame_rate") = 1000.0,
+        py::kw_only(), py::arg("times") = py::none(), py::arg("model") = sensor::SensorModel{},
+        py::arg("options") = sensor::ContactOptions{}, py::arg("frame_rate") = 1000.0,
         R"doc(
 Contacts of pad readings taken at known pad poses.
 
@@ -362,9 +366,10 @@ Options that the chosen policy or index does not use must stay at their defaults
                        std::string average_mode, double alpha, double max_normal_angle,
                        double normal_sigma, double curvature_prior, std::size_t leaf_size,
                        double max_load_factor) {
-             const CloudOptions o{association_radius, process_noise, gate_chi2, initial_sigma,
-                                  std::move(average_mode), alpha, max_normal_angle,
-                                  normal_sigma, curvature_prior, leaf_size, max_load_factor};
+             const CloudOptions o{
+                 association_radius,      process_noise, gate_chi2,        initial_sigma,
+                 std::move(average_mode), alpha,         max_normal_angle, normal_sigma,
+                 curvature_prior,         leaf_size,     max_load_factor};
              const int p = enum_from(policy, kPolicies, "policy");
              const int i = enum_from(index, kIndexes, "index");
              check_unused(o, p, i);
@@ -523,7 +528,8 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
           "The confident points as a PointCloud with fields 'observations', 'cov_xx' .. "
           "'cov_zz', 'last_time' (and normals with the surfel policy).")
       .def("clear", [](PyContactCloud& c) { c.impl->clear(); })
-      .def("reserve", [](PyContactCloud& c, std::size_t n) { c.impl->reserve(n); }, py::arg("n"))
+      .def(
+          "reserve", [](PyContactCloud& c, std::size_t n) { c.impl->reserve(n); }, py::arg("n"))
       .def_property_readonly("memory_bytes",
                              [](const PyContactCloud& c) { return c.impl->memory_bytes(); })
       .def("__repr__", [](const PyContactCloud& c) {

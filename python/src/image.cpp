@@ -22,7 +22,9 @@ constexpr std::pair<std::string_view, im::PostProcess> kPost[] = {
     {"mean3x3", im::PostProcess::mean3x3},
     {"median3x3", im::PostProcess::median3x3}};
 constexpr std::pair<std::string_view, im::Healing> kHealing[] = {
-    {"linear", im::Healing::linear}, {"row_mean", im::Healing::row_mean}, {"none", im::Healing::none}};
+    {"linear", im::Healing::linear},
+    {"row_mean", im::Healing::row_mean},
+    {"none", im::Healing::none}};
 constexpr std::pair<std::string_view, im::HeightSource> kSources[] = {
     {"raw", im::HeightSource::raw}, {"quantised", im::HeightSource::quantised}};
 constexpr std::pair<std::string_view, im::GradientSource> kGradientSources[] = {
@@ -112,10 +114,11 @@ counter-clockwise with y up.)doc");
       std::vector<std::string>(im::kEdgeFeatureNames.begin(), im::kEdgeFeatureNames.end());
 
   py::class_<im::KMeans1dResult>(m, "KMeans1dResult", "A 1-D clustering, clusters ascending.")
-      .def_property_readonly("status",
-                             [](const im::KMeans1dResult& r) { return std::string(to_string(r.status)); })
+      .def_property_readonly(
+          "status", [](const im::KMeans1dResult& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &im::KMeans1dResult::message)
-      .def_readonly("k", &im::KMeans1dResult::k, "clusters found: min(k_requested, distinct values)")
+      .def_readonly("k", &im::KMeans1dResult::k,
+                    "clusters found: min(k_requested, distinct values)")
       .def_readonly("k_requested", &im::KMeans1dResult::k_requested)
       .def_readonly("centroids", &im::KMeans1dResult::centroids)
       .def_readonly("lower", &im::KMeans1dResult::lower, "smallest value of each cluster")
@@ -147,7 +150,8 @@ counter-clockwise with y up.)doc");
           py::gil_scoped_release release;
           r = im::kmeans1d_lloyd(v, {k, seed, max_iterations});
         } else {
-          throw py::value_error("kmeans1d: method must be 'exact' or 'lloyd', got '" + method + "'");
+          throw py::value_error("kmeans1d: method must be 'exact' or 'lloyd', got '" + method +
+                                "'");
         }
         raise_unless_ok(r, true);
         return r;
@@ -158,12 +162,15 @@ counter-clockwise with y up.)doc");
       "'lloyd' (k-means++ start). Raises ValueError for empty or non-finite values.");
 
   py::class_<im::Segmentation>(m, "Segmentation", "The segmentation of one image.")
-      .def_property_readonly("classes", [](const im::Segmentation& s) { return s.classes; },
-                             "uint8 class per pixel: 0 background .. k-1 high pressure")
-      .def_property_readonly("quantised", [](const im::Segmentation& s) { return s.quantised; },
-                             "each pixel replaced by its cluster's centroid")
-      .def_property_readonly("high", [](const im::Segmentation& s) { return s.high; },
-                             "uint8 mask of the HPR pixels after removal of small regions")
+      .def_property_readonly(
+          "classes", [](const im::Segmentation& s) { return s.classes; },
+          "uint8 class per pixel: 0 background .. k-1 high pressure")
+      .def_property_readonly(
+          "quantised", [](const im::Segmentation& s) { return s.quantised; },
+          "each pixel replaced by its cluster's centroid")
+      .def_property_readonly(
+          "high", [](const im::Segmentation& s) { return s.high; },
+          "uint8 mask of the HPR pixels after removal of small regions")
       .def_property_readonly("high_raw", [](const im::Segmentation& s) { return s.high_raw; })
       .def_readonly("kmeans", &im::Segmentation::kmeans)
       .def_readonly("regions", &im::Segmentation::regions, "HPR components kept")
@@ -178,8 +185,9 @@ counter-clockwise with y up.)doc");
       [](const ArrayD& image, int k, const std::string& polarity, int min_area, int connectivity,
          int histogram_levels) -> py::object {
         const Frames f = frames_of(image, "segment");
-        im::Segmenter seg(segmentation_config(k, polarity, min_area, connectivity, histogram_levels),
-                          f.rows, f.cols);
+        im::Segmenter seg(
+            segmentation_config(k, polarity, min_area, connectivity, histogram_levels), f.rows,
+            f.cols);
         std::vector<im::Segmentation> out;
         for (py::ssize_t i = 0; i < f.frames; ++i) {
           {
@@ -359,8 +367,9 @@ counter-clockwise with y up.)doc");
                     "mean contour gradient magnitude of the largest HPR (feature 18)")
       .def_readonly("regional", &im::Recognition::regional, "the 11 regional features")
       .def_readonly("edge_features", &im::Recognition::edge_features, "the 23 edge features")
-      .def_readonly("hybrid", &im::Recognition::hybrid,
-                    "rows*cols gradient magnitudes (row-major) followed by the 11 regional features");
+      .def_readonly(
+          "hybrid", &im::Recognition::hybrid,
+          "rows*cols gradient magnitudes (row-major) followed by the 11 regional features");
 
   py::class_<PyRecognizer>(m, "Recognizer", R"doc(
 The second paper's chain for images of rows x cols: segmentation, HPR descriptors, contour
@@ -372,7 +381,8 @@ gradient_threshold) and the feature vectors.)doc")
              im::RecognizerConfig cfg;
              cfg.segmentation = segmentation_config(k, polarity, min_area, connectivity, 65536);
              cfg.gradient_source = enum_from(gradient_source, kGradientSources, "gradient_source");
-             return PyRecognizer{im::Recognizer<>(rows, cols, cfg, im::GradientThreshold{gradient_threshold})};
+             return PyRecognizer{
+                 im::Recognizer<>(rows, cols, cfg, im::GradientThreshold{gradient_threshold})};
            }),
            py::arg("rows") = 32, py::arg("cols") = 32, py::kw_only(),
            py::arg("gradient_threshold") = 25.0, py::arg("gradient_source") = "raw",
@@ -410,10 +420,12 @@ gradient_threshold) and the feature vectors.)doc")
                   error = "frame " + std::to_string(i) + ": " + x.message;
                   break;
                 }
-                std::copy_n(x.regional.data(), x.regional.size(), regional.mutable_data() + i * x.regional.size());
+                std::copy_n(x.regional.data(), x.regional.size(),
+                            regional.mutable_data() + i * x.regional.size());
                 std::copy_n(x.edge_features.data(), x.edge_features.size(),
                             edge.mutable_data() + i * x.edge_features.size());
-                std::copy_n(x.hybrid.data(), x.hybrid.size(), hybrid.mutable_data() + i * x.hybrid.size());
+                std::copy_n(x.hybrid.data(), x.hybrid.size(),
+                            hybrid.mutable_data() + i * x.hybrid.size());
                 edged.mutable_data()[i] = x.edged;
                 gm.mutable_data()[i] = x.contour_gradient;
               }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // taxel.io: readers and writers of PLY clouds and meshes, pressure images, contacts and pad
 // poses; registration.model_cloud for mesh models.
-#include "common.hpp"
 #include "taxel/io.hpp"
+#include "common.hpp"
 #include "taxel/registration/model.hpp"
 #ifdef TAXEL_PYTHON_HAVE_PNG
 #include "taxel/io/png.hpp"
@@ -19,8 +19,9 @@ py::array_t<std::uint32_t> triangles_array(const Triangles& t) {
   return out;
 }
 
-Triangles triangles_from(const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& a,
-                         std::size_t vertices) {
+Triangles triangles_from(
+    const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& a,
+    std::size_t vertices) {
   require_shape(a, {-1, 3}, "triangles", "(T, 3)");
   Triangles t(static_cast<std::size_t>(a.shape(0)));
   for (py::ssize_t i = 0; i < a.size(); ++i) {
@@ -29,7 +30,8 @@ Triangles triangles_from(const py::array_t<std::int64_t, py::array::c_style | py
       throw py::value_error("triangles: vertex index " + std::to_string(v) + " outside [0, " +
                             std::to_string(vertices) + ")");
     }
-    t[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] = static_cast<std::uint32_t>(v);
+    t[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] =
+        static_cast<std::uint32_t>(v);
   }
   return t;
 }
@@ -101,9 +103,11 @@ write leaves no partial file.)doc");
         } else if (ext == ".csv") {
           bytes = io::encode_image_csv(Eigen::Map<const image::ImageD>(image.data(), rows, cols));
         } else if (ext == ".pgm") {
-          bytes = io::encode_pgm(Eigen::Map<const image::ImageD>(image.data(), rows, cols), lo, hi, maxval);
+          bytes = io::encode_pgm(Eigen::Map<const image::ImageD>(image.data(), rows, cols), lo, hi,
+                                 maxval);
         } else {
-          throw py::value_error("write_image: unknown format '" + ext + "' (expected .csv, .pgm or .npy)");
+          throw py::value_error("write_image: unknown format '" + ext +
+                                "' (expected .csv, .pgm or .npy)");
         }
         io::write_file(path, bytes);
       },
@@ -146,7 +150,8 @@ write leaves no partial file.)doc");
           pad.mutable_data()[i] = static_cast<std::int64_t>(poses[i].pad);
           time.mutable_data()[i] = poses[i].time;
           for (int r = 0; r < 4; ++r) {
-            for (int c = 0; c < 4; ++c) pose.mutable_data()[16 * i + 4 * r + c] = poses[i].pose.matrix()(r, c);
+            for (int c = 0; c < 4; ++c)
+              pose.mutable_data()[16 * i + 4 * r + c] = poses[i].pose.matrix()(r, c);
           }
         }
         py::dict d;

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // taxel.learn: LinearSvm and its competitors (Knn, Lda, RbfSvm, Mlp) with fit / predict /
 // decision_function on arrays, cross-validation, the 5x2cv test and LIBLINEAR model files.
+#include "taxel/learn.hpp"
 #include "common.hpp"
 #include "taxel/io/file.hpp"
 #include "taxel/io/libsvm_format.hpp"
-#include "taxel/learn.hpp"
 
 namespace taxel::python {
 namespace {
@@ -40,19 +40,19 @@ void warn_not_converged(const Outcome& o) {
 }
 
 constexpr std::pair<std::string_view, ln::SvmLoss> kLosses[] = {{"l2", ln::SvmLoss::l2},
-                                                                  {"l1", ln::SvmLoss::l1}};
+                                                                {"l1", ln::SvmLoss::l1}};
 
 constexpr std::pair<std::string_view, ln::KnnMetric> kMetrics[] = {
-      {"euclidean", ln::KnnMetric::euclidean}, {"manhattan", ln::KnnMetric::manhattan}};
+    {"euclidean", ln::KnnMetric::euclidean}, {"manhattan", ln::KnnMetric::manhattan}};
 
 constexpr std::pair<std::string_view, ln::KnnWeighting> kWeighting[] = {
-      {"uniform", ln::KnnWeighting::uniform}, {"distance", ln::KnnWeighting::distance}};
+    {"uniform", ln::KnnWeighting::uniform}, {"distance", ln::KnnWeighting::distance}};
 
 constexpr std::pair<std::string_view, ln::MlpActivation> kActivations[] = {
-      {"tanh", ln::MlpActivation::tanh}, {"relu", ln::MlpActivation::relu}};
+    {"tanh", ln::MlpActivation::tanh}, {"relu", ln::MlpActivation::relu}};
 
 constexpr std::pair<std::string_view, ln::MlpOptimizer> kOptimizers[] = {
-      {"adam", ln::MlpOptimizer::adam}, {"sgd", ln::MlpOptimizer::sgd}};
+    {"adam", ln::MlpOptimizer::adam}, {"sgd", ln::MlpOptimizer::sgd}};
 constexpr std::pair<std::string_view, ln::NoiseTarget> kNoiseTargets[] = {
     {"test_only", ln::NoiseTarget::test_only}, {"both", ln::NoiseTarget::both}};
 
@@ -140,8 +140,9 @@ auto with_classifier(const py::object& obj, Fn&& fn) {
   if (py::isinstance<ln::Lda>(obj)) return fn(obj.cast<const ln::Lda&>());
   if (py::isinstance<ln::RbfSvm>(obj)) return fn(obj.cast<const ln::RbfSvm&>());
   if (py::isinstance<ln::Mlp>(obj)) return fn(obj.cast<const ln::Mlp&>());
-  throw py::type_error("expected a taxel.learn classifier (LinearSvm, Knn, Lda, RbfSvm, Mlp), got " +
-                       std::string(py::str(py::type::of(obj))));
+  throw py::type_error(
+      "expected a taxel.learn classifier (LinearSvm, Knn, Lda, RbfSvm, Mlp), got " +
+      std::string(py::str(py::type::of(obj))));
 }
 
 }  // namespace
@@ -173,8 +174,9 @@ files.)doc");
            py::kw_only(), py::arg("C") = 1.0, py::arg("loss") = "l2", py::arg("eps") = 0.1,
            py::arg("bias") = -1.0, py::arg("max_iterations") = 1000, py::arg("shrinking") = true,
            py::arg("seed") = 1, py::arg("class_weights") = std::map<int, double>{})
-      .def_property_readonly("coef_", [](const ln::LinearSvm& s) { return s.weights(); },
-                             "(n_problems, n_features) weights; one row for two classes")
+      .def_property_readonly(
+          "coef_", [](const ln::LinearSvm& s) { return s.weights(); },
+          "(n_problems, n_features) weights; one row for two classes")
       .def_property_readonly(
           "intercept_",
           [](const ln::LinearSvm& s) {
@@ -185,15 +187,18 @@ files.)doc");
       .def_property_readonly("solver_type", &ln::LinearSvm::solver_type)
       .def_property_readonly("iterations",
                              [](const ln::LinearSvm& s) { return s.info().iterations; })
-      .def_property_readonly("objective", [](const ln::LinearSvm& s) { return s.info().objective; },
-                             "final dual objective per binary problem")
-      .def("to_liblinear", [](const ln::LinearSvm& s) { return s.save(); },
-           "the model as LIBLINEAR model-file text")
+      .def_property_readonly(
+          "objective", [](const ln::LinearSvm& s) { return s.info().objective; },
+          "final dual objective per binary problem")
+      .def(
+          "to_liblinear", [](const ln::LinearSvm& s) { return s.save(); },
+          "the model as LIBLINEAR model-file text")
       .def_static(
           "from_liblinear", [](const std::string& text) { return ln::LinearSvm::load(text); },
           py::arg("text"), "a model from LIBLINEAR model-file text")
       .def(
-          "save", [](const ln::LinearSvm& s, const std::string& path) { io::write_file(path, s.save()); },
+          "save",
+          [](const ln::LinearSvm& s, const std::string& path) { io::write_file(path, s.save()); },
           py::arg("path"), "Writes a LIBLINEAR model file (atomically; OSError on failure).")
       .def_static(
           "load",
@@ -203,7 +208,7 @@ files.)doc");
   bind_classifier<ln::Knn>(m, "Knn", "k nearest neighbours; decision values are vote shares.")
       .def(py::init([](int k, const std::string& metric, const std::string& weighting) {
              return ln::Knn(ln::KnnConfig{k, enum_from(metric, kMetrics, "metric"),
-                             enum_from(weighting, kWeighting, "weighting")});
+                                          enum_from(weighting, kWeighting, "weighting")});
            }),
            py::kw_only(), py::arg("k") = 5, py::arg("metric") = "euclidean",
            py::arg("weighting") = "uniform");
@@ -219,10 +224,10 @@ files.)doc");
   bind_classifier<ln::RbfSvm>(m, "RbfSvm",
                               "Kernel SVM with K = exp(-gamma |x - z|^2) (LIBSVM's C-SVC, "
                               "one-vs-one); gamma 0 means 1 / n_features.")
-      .def(py::init([](double C, double gamma, double eps, double cache_mb,
-                       long long max_iterations) {
-             return ln::RbfSvm(ln::RbfSvmConfig{C, gamma, eps, cache_mb, max_iterations});
-           }),
+      .def(py::init(
+               [](double C, double gamma, double eps, double cache_mb, long long max_iterations) {
+                 return ln::RbfSvm(ln::RbfSvmConfig{C, gamma, eps, cache_mb, max_iterations});
+               }),
            py::kw_only(), py::arg("C") = 1.0, py::arg("gamma") = 0.0, py::arg("eps") = 1e-3,
            py::arg("cache_mb") = 100.0, py::arg("max_iterations") = 0);
 
@@ -233,9 +238,10 @@ files.)doc");
                        const std::string& optimizer, double learning_rate, double momentum,
                        double l2, int epochs, int batch_size, double tolerance, int patience,
                        std::uint64_t seed) {
-             return ln::Mlp(ln::MlpConfig{std::move(hidden), enum_from(activation, kActivations, "activation"),
-                             enum_from(optimizer, kOptimizers, "optimizer"), learning_rate,
-                             momentum, l2, epochs, batch_size, tolerance, patience, seed});
+             return ln::Mlp(
+                 ln::MlpConfig{std::move(hidden), enum_from(activation, kActivations, "activation"),
+                               enum_from(optimizer, kOptimizers, "optimizer"), learning_rate,
+                               momentum, l2, epochs, batch_size, tolerance, patience, seed});
            }),
            py::kw_only(), py::arg("hidden") = std::vector<int>{32}, py::arg("activation") = "tanh",
            py::arg("optimizer") = "adam", py::arg("learning_rate") = 1e-2,
@@ -248,7 +254,8 @@ files.)doc");
                              [](const ln::CvReport& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &ln::CvReport::message)
       .def_readonly("accuracy", &ln::CvReport::accuracy)
-      .def_property_readonly("classes", [](const ln::CvReport& r) { return vector_array(r.classes); })
+      .def_property_readonly("classes",
+                             [](const ln::CvReport& r) { return vector_array(r.classes); })
       .def_readonly("confusion", &ln::CvReport::confusion,
                     "[true class][predicted class], in `classes` order")
       .def_readonly("per_class_accuracy", &ln::CvReport::per_class_accuracy)
@@ -283,8 +290,8 @@ files.)doc");
       "group in one fold; snr_db adds white noise to the test (or both) features.");
 
   py::class_<ln::FiveByTwoResult>(m, "FiveByTwoResult", "Dietterich's 5x2cv paired t test.")
-      .def_property_readonly("status",
-                             [](const ln::FiveByTwoResult& r) { return std::string(to_string(r.status)); })
+      .def_property_readonly(
+          "status", [](const ln::FiveByTwoResult& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &ln::FiveByTwoResult::message)
       .def_property_readonly(
           "differences",
@@ -319,9 +326,9 @@ files.)doc");
 
   m.def(
       "five_by_two_cv",
-      [](const py::object& a, const py::object& b, ArrayD x, ArrayI y,
-         std::optional<ArrayI> groups, double alpha, std::uint64_t seed, bool grouped,
-         double snr_db, const std::string& noise_target) {
+      [](const py::object& a, const py::object& b, ArrayD x, ArrayI y, std::optional<ArrayI> groups,
+         double alpha, std::uint64_t seed, bool grouped, double snr_db,
+         const std::string& noise_target) {
         const DataArrays d = data_arrays(std::move(x), std::move(y), std::move(groups));
         ln::FiveByTwoOptions opt;
         opt.alpha = alpha;

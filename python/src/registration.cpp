@@ -129,14 +129,14 @@ with field_cell > 0 [m], a closest-point field for approximate correspondences.)
           "for a non-finite query");
 
   py::class_<reg::IcpResult>(m, "IcpResult", "The outcome of one alignment.")
-      .def_property_readonly("status",
-                             [](const reg::IcpResult& r) { return std::string(to_string(r.status)); },
-                             "'ok', 'not_converged', 'degenerate' or 'invalid_input'")
+      .def_property_readonly(
+          "status", [](const reg::IcpResult& r) { return std::string(to_string(r.status)); },
+          "'ok', 'not_converged', 'degenerate' or 'invalid_input'")
       .def_readonly("message", &reg::IcpResult::message)
       .def_property_readonly("ok", [](const reg::IcpResult& r) { return r.ok(); })
-      .def_property_readonly("transform",
-                             [](const reg::IcpResult& r) { return pose_array(r.transform); },
-                             "T_target_source, a 4x4 matrix")
+      .def_property_readonly(
+          "transform", [](const reg::IcpResult& r) { return pose_array(r.transform); },
+          "T_target_source, a 4x4 matrix")
       .def_readonly("rmse", &reg::IcpResult::rmse, "RMS distance of the inlier pairs [m]")
       .def_readonly("inlier_fraction", &reg::IcpResult::inlier_fraction)
       .def_readonly("inliers", &reg::IcpResult::inliers)
@@ -152,32 +152,30 @@ with field_cell > 0 [m], a closest-point field for approximate correspondences.)
 Iterative closest point. error: 'point_to_plane' (default) or 'point_to_point'; kernel:
 'none', 'huber', 'cauchy', 'geman_mcclure' or 'tukey', with `kernel_scale` [m] (None: the
 kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.)doc")
-      .def(py::init([](const std::string& error, const std::string& kernel,
-                       std::optional<double> kernel_scale, int max_iterations,
-                       double max_distance, double trim_fraction, double translation_tolerance,
-                       double rotation_tolerance, double relative_error_tolerance,
-                       std::size_t min_correspondences, bool approximate,
-                       std::size_t coarse_points) {
-             enum_from(error, kErrors, "error");
-             reg::IcpConfig cfg{max_iterations,        max_distance,
-                                trim_fraction,         translation_tolerance,
-                                rotation_tolerance,    relative_error_tolerance,
-                                min_correspondences,   approximate,
-                                coarse_points};
-             (void)reg::Icp<>(cfg);  // validates the options
-             const double scale = kernel_scale.value_or(default_scale(kernel));
-             if (kernel != "none" && (!(scale > 0) || !std::isfinite(scale))) {
-               throw py::value_error("Icp: kernel_scale must be finite and > 0 [m]");
-             }
-             return PyIcp{error, kernel, scale, cfg};
-           }),
-           py::arg("error") = "point_to_plane", py::arg("kernel") = "none", py::kw_only(),
-           py::arg("kernel_scale") = py::none(), py::arg("max_iterations") = 50,
-           py::arg("max_distance") = std::numeric_limits<double>::infinity(),
-           py::arg("trim_fraction") = 0.0, py::arg("translation_tolerance") = 1e-6,
-           py::arg("rotation_tolerance") = 1e-6, py::arg("relative_error_tolerance") = 0.0,
-           py::arg("min_correspondences") = 0, py::arg("approximate") = false,
-           py::arg("coarse_points") = 0)
+      .def(
+          py::init([](const std::string& error, const std::string& kernel,
+                      std::optional<double> kernel_scale, int max_iterations, double max_distance,
+                      double trim_fraction, double translation_tolerance, double rotation_tolerance,
+                      double relative_error_tolerance, std::size_t min_correspondences,
+                      bool approximate, std::size_t coarse_points) {
+            enum_from(error, kErrors, "error");
+            reg::IcpConfig cfg{max_iterations,        max_distance,       trim_fraction,
+                               translation_tolerance, rotation_tolerance, relative_error_tolerance,
+                               min_correspondences,   approximate,        coarse_points};
+            (void)reg::Icp<>(cfg);  // validates the options
+            const double scale = kernel_scale.value_or(default_scale(kernel));
+            if (kernel != "none" && (!(scale > 0) || !std::isfinite(scale))) {
+              throw py::value_error("Icp: kernel_scale must be finite and > 0 [m]");
+            }
+            return PyIcp{error, kernel, scale, cfg};
+          }),
+          py::arg("error") = "point_to_plane", py::arg("kernel") = "none", py::kw_only(),
+          py::arg("kernel_scale") = py::none(), py::arg("max_iterations") = 50,
+          py::arg("max_distance") = std::numeric_limits<double>::infinity(),
+          py::arg("trim_fraction") = 0.0, py::arg("translation_tolerance") = 1e-6,
+          py::arg("rotation_tolerance") = 1e-6, py::arg("relative_error_tolerance") = 0.0,
+          py::arg("min_correspondences") = 0, py::arg("approximate") = false,
+          py::arg("coarse_points") = 0)
       .def_readonly("error", &PyIcp::error)
       .def_readonly("kernel", &PyIcp::kernel)
       .def_readonly("kernel_scale", &PyIcp::kernel_scale)
@@ -202,11 +200,12 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
       .def_readonly("score", &reg::ModelMatch::score, "truncated RMS distance [m], lower is better")
       .def_readonly("rmse", &reg::ModelMatch::rmse)
       .def_readonly("inlier_fraction", &reg::ModelMatch::inlier_fraction)
-      .def_property_readonly("transform",
-                             [](const reg::ModelMatch& r) { return pose_array(r.transform); },
-                             "T_model_cloud, a 4x4 matrix")
       .def_property_readonly(
-          "icp_status", [](const reg::ModelMatch& r) { return std::string(to_string(r.icp_status)); })
+          "transform", [](const reg::ModelMatch& r) { return pose_array(r.transform); },
+          "T_model_cloud, a 4x4 matrix")
+      .def_property_readonly(
+          "icp_status",
+          [](const reg::ModelMatch& r) { return std::string(to_string(r.icp_status)); })
       .def_readonly("exact", &reg::ModelMatch::exact)
       .def_readonly("starts", &reg::ModelMatch::starts)
       .def("__repr__", [](const reg::ModelMatch& r) {
@@ -215,7 +214,8 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
 
   py::class_<reg::ObjectRecognition>(m, "ObjectRecognition", "The answer of recognize().")
       .def_property_readonly(
-          "status", [](const reg::ObjectRecognition& r) { return std::string(to_string(r.status)); })
+          "status",
+          [](const reg::ObjectRecognition& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &reg::ObjectRecognition::message)
       .def_readonly("ranking", &reg::ObjectRecognition::ranking, "ModelMatch list, best first")
       .def_readonly("best", &reg::ObjectRecognition::best, "the best model's name, or 'unknown'")
@@ -229,11 +229,10 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
   py::class_<reg::ObjectLibrary<double>>(m, "ObjectLibrary", R"doc(
 Named object models; recognize() ranks them by how well each explains a cloud (multi-start
 point-to-plane ICP, then a truncated RMS score [m]).)doc")
-      .def(py::init([](int coarse_iterations, std::size_t coarse_points,
-                       std::size_t refine_points, double coarse_trim, bool pca_starts,
-                       int rotation_starts, int refine_best, int exact_models,
-                       double hopeless_factor, double field_cell, double score_gate,
-                       double unknown_score) {
+      .def(py::init([](int coarse_iterations, std::size_t coarse_points, std::size_t refine_points,
+                       double coarse_trim, bool pca_starts, int rotation_starts, int refine_best,
+                       int exact_models, double hopeless_factor, double field_cell,
+                       double score_gate, double unknown_score) {
              reg::LibraryConfig c;
              c.coarse_iterations = coarse_iterations;
              c.coarse_points = coarse_points;
@@ -271,7 +270,8 @@ point-to-plane ICP, then a truncated RMS score [m]).)doc")
       .def_property_readonly("names",
                              [](const reg::ObjectLibrary<double>& lib) {
                                std::vector<std::string> out;
-                               for (std::size_t i = 0; i < lib.size(); ++i) out.push_back(lib.name(i));
+                               for (std::size_t i = 0; i < lib.size(); ++i)
+                                 out.push_back(lib.name(i));
                                return out;
                              })
       .def(

@@ -19,7 +19,8 @@ ArrayD per_point(const Sh& shape, const ArrayD& points, Fn&& fn, int width) {
   const double* p = points.data();
   double* o = out.mutable_data();
   py::gil_scoped_release release;
-  for (py::ssize_t i = 0; i < n; ++i) fn(shape, Vec3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]), o + i * width);
+  for (py::ssize_t i = 0; i < n; ++i)
+    fn(shape, Vec3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]), o + i * width);
   return out;
 }
 
@@ -29,22 +30,32 @@ void shape_methods(py::class_<Sh>& cls) {
   cls.def(
          "signed_distance",
          [](const Sh& s, const ArrayD& points) {
-           return per_point(s, points, [](const Sh& sh, const Vec3d& p, double* o) { *o = sh.signed_distance(p); }, 1);
+           return per_point(
+               s, points,
+               [](const Sh& sh, const Vec3d& p, double* o) { *o = sh.signed_distance(p); }, 1);
          },
          py::arg("points"), "(N,) signed distances [m] of (N, 3) points, outside positive")
       .def(
           "closest_point",
           [](const Sh& s, const ArrayD& points) {
-            return per_point(s, points, [](const Sh& sh, const Vec3d& p, double* o) { store(o, Vec3d(sh.closest_point(p))); }, 3);
+            return per_point(
+                s, points,
+                [](const Sh& sh, const Vec3d& p, double* o) {
+                  store(o, Vec3d(sh.closest_point(p)));
+                },
+                3);
           },
           py::arg("points"), "(N, 3) closest surface points")
       .def(
           "normal",
           [](const Sh& s, const ArrayD& points) {
-            return per_point(s, points, [](const Sh& sh, const Vec3d& p, double* o) { store(o, Vec3d(sh.normal(p))); }, 3);
+            return per_point(
+                s, points,
+                [](const Sh& sh, const Vec3d& p, double* o) { store(o, Vec3d(sh.normal(p))); }, 3);
           },
           py::arg("points"), "(N, 3) outward unit normals at the closest surface points")
-      .def("surface_area", [](const Sh& s) { return sm::surface_area(s); }, "[m^2]")
+      .def(
+          "surface_area", [](const Sh& s) { return sm::surface_area(s); }, "[m^2]")
       .def(
           "sample_surface",
           [](const Sh& s, std::size_t count, std::uint64_t seed) {
@@ -63,8 +74,8 @@ void shape_methods(py::class_<Sh>& cls) {
           "About one surface point per spacing^2 [m]");
 }
 
-using AnyShape = std::variant<sm::Sphere, sm::Cylinder, sm::Box, sm::Cone, sm::Ellipsoid,
-                              sm::Torus, sm::TriangleMesh>;
+using AnyShape = std::variant<sm::Sphere, sm::Cylinder, sm::Box, sm::Cone, sm::Ellipsoid, sm::Torus,
+                              sm::TriangleMesh>;
 
 AnyShape shape_from(const py::object& obj) {
   if (py::isinstance<sm::Sphere>(obj)) return obj.cast<sm::Sphere>();
@@ -74,7 +85,8 @@ AnyShape shape_from(const py::object& obj) {
   if (py::isinstance<sm::Ellipsoid>(obj)) return obj.cast<sm::Ellipsoid>();
   if (py::isinstance<sm::Torus>(obj)) return obj.cast<sm::Torus>();
   if (py::isinstance<sm::TriangleMesh>(obj)) return obj.cast<sm::TriangleMesh>();
-  throw py::type_error("expected a taxel.sim shape, got " + std::string(py::str(py::type::of(obj))));
+  throw py::type_error("expected a taxel.sim shape, got " +
+                       std::string(py::str(py::type::of(obj))));
 }
 
 /// A simulated exploration: frames of pad readings, poses and the contacts they gave.
@@ -120,10 +132,10 @@ std::size_t pads_per_frame(const PyExploration& e) {
   return pads;
 }
 
-#define TAXEL_EXPLORATION_ARGS                                                          \
+#define TAXEL_EXPLORATION_ARGS                                                               \
   py::arg("sensor") = sensor::SensorModel{}, py::arg("contacts") = sensor::ContactOptions{}, \
-      py::arg("frame_rate") = 1000.0, py::arg("indentation") = 1e-3,                   \
-      py::arg("object_pose") = py::none(), py::arg("seed") = 1
+  py::arg("frame_rate") = 1000.0, py::arg("indentation") = 1e-3,                             \
+  py::arg("object_pose") = py::none(), py::arg("seed") = 1
 
 }  // namespace
 
@@ -134,14 +146,16 @@ sampling, tactile explorations with a pad of the sensor model, surface errors, a
 palm-grasp pressure-image synthesiser.)doc");
 
   py::class_<sm::Sphere> sphere(m, "Sphere", "Sphere of `radius` [m] centred at the origin.");
-  sphere.def(py::init<double>(), py::arg("radius") = 0.04).def_readonly("radius", &sm::Sphere::radius);
+  sphere.def(py::init<double>(), py::arg("radius") = 0.04)
+      .def_readonly("radius", &sm::Sphere::radius);
   shape_methods(sphere);
   py::class_<sm::Cylinder> cylinder(m, "Cylinder", "Capped cylinder along z.");
   cylinder.def(py::init<double, double>(), py::arg("radius") = 0.03, py::arg("half_height") = 0.05)
       .def_readonly("radius", &sm::Cylinder::radius)
       .def_readonly("half_height", &sm::Cylinder::half_height);
   shape_methods(cylinder);
-  py::class_<sm::Box> box(m, "Box", "Box of `half_extents` [m] centred at the origin, axis-aligned.");
+  py::class_<sm::Box> box(m, "Box",
+                          "Box of `half_extents` [m] centred at the origin, axis-aligned.");
   box.def(py::init([](const Eigen::Vector3d& h) { return sm::Box(h); }),
           py::arg("half_extents") = Eigen::Vector3d(0.04, 0.03, 0.02))
       .def_readonly("half_extents", &sm::Box::half_extents);
@@ -151,34 +165,42 @@ palm-grasp pressure-image synthesiser.)doc");
       .def_readonly("radius", &sm::Cone::radius)
       .def_readonly("height", &sm::Cone::height);
   shape_methods(cone);
-  py::class_<sm::Ellipsoid> ellipsoid(m, "Ellipsoid", "Ellipsoid of `semi_axes` [m] along x, y, z.");
-  ellipsoid.def(py::init([](const Eigen::Vector3d& e) { return sm::Ellipsoid(e); }),
-                py::arg("semi_axes") = Eigen::Vector3d(0.05, 0.035, 0.025))
+  py::class_<sm::Ellipsoid> ellipsoid(m, "Ellipsoid",
+                                      "Ellipsoid of `semi_axes` [m] along x, y, z.");
+  ellipsoid
+      .def(py::init([](const Eigen::Vector3d& e) { return sm::Ellipsoid(e); }),
+           py::arg("semi_axes") = Eigen::Vector3d(0.05, 0.035, 0.025))
       .def_readonly("semi_axes", &sm::Ellipsoid::semi_axes);
   shape_methods(ellipsoid);
   py::class_<sm::Torus> torus(m, "Torus", "Torus around z.");
-  torus.def(py::init<double, double>(), py::arg("major_radius") = 0.04, py::arg("minor_radius") = 0.015)
+  torus
+      .def(py::init<double, double>(), py::arg("major_radius") = 0.04,
+           py::arg("minor_radius") = 0.015)
       .def_readonly("major_radius", &sm::Torus::major_radius)
       .def_readonly("minor_radius", &sm::Torus::minor_radius);
   shape_methods(torus);
   py::class_<sm::TriangleMesh> mesh(m, "TriangleMesh",
                                     "A closed triangle mesh; closest points through a bounding-"
                                     "volume hierarchy.");
-  mesh.def(py::init([](const ArrayD& vertices,
-                       const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& triangles) {
-             std::vector<Vec3d> v = points_from(vertices, "vertices");
-             require_shape(triangles, {-1, 3}, "triangles", "(T, 3)");
-             std::vector<sm::TriangleMesh::Triangle> t(static_cast<std::size_t>(triangles.shape(0)));
-             for (py::ssize_t i = 0; i < triangles.size(); ++i) {
-               const std::int64_t k = triangles.data()[i];
-               if (k < 0 || k > std::numeric_limits<std::uint32_t>::max()) {
-                 throw py::value_error("triangles: negative or too large vertex index " + std::to_string(k));
-               }
-               t[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] = static_cast<std::uint32_t>(k);
-             }
-             return sm::TriangleMesh(std::move(v), std::move(t));
-           }),
-           py::arg("vertices"), py::arg("triangles"));
+  mesh.def(
+      py::init([](const ArrayD& vertices,
+                  const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>&
+                      triangles) {
+        std::vector<Vec3d> v = points_from(vertices, "vertices");
+        require_shape(triangles, {-1, 3}, "triangles", "(T, 3)");
+        std::vector<sm::TriangleMesh::Triangle> t(static_cast<std::size_t>(triangles.shape(0)));
+        for (py::ssize_t i = 0; i < triangles.size(); ++i) {
+          const std::int64_t k = triangles.data()[i];
+          if (k < 0 || k > std::numeric_limits<std::uint32_t>::max()) {
+            throw py::value_error("triangles: negative or too large vertex index " +
+                                  std::to_string(k));
+          }
+          t[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] =
+              static_cast<std::uint32_t>(k);
+        }
+        return sm::TriangleMesh(std::move(v), std::move(t));
+      }),
+      py::arg("vertices"), py::arg("triangles"));
   shape_methods(mesh);
   m.def("icosphere", &sm::icosphere, py::arg("radius"), py::arg("subdivisions"),
         "A sphere mesh: an icosahedron subdivided `subdivisions` times, vertices on the sphere.");
@@ -191,7 +213,8 @@ palm-grasp pressure-image synthesiser.)doc");
       [](const py::object& shape, const ArrayD& points, const std::optional<ArrayD>& object_pose) {
         const AnyShape s = shape_from(shape);
         const std::vector<Vec3d> pts = points_from(points, "points");
-        const Isometry3d pose = object_pose ? pose_from(*object_pose, "object_pose") : Isometry3d::Identity();
+        const Isometry3d pose =
+            object_pose ? pose_from(*object_pose, "object_pose") : Isometry3d::Identity();
         const sm::SurfaceError e = std::visit(
             [&](const auto& sh) {
               using Sh = std::decay_t<decltype(sh)>;
@@ -211,12 +234,14 @@ palm-grasp pressure-image synthesiser.)doc");
 
   py::class_<PyExploration>(m, "Exploration", "Frames of pad readings, poses and contacts.")
       .def("__len__", [](const PyExploration& e) { return e.frames.size(); })
-      .def_property_readonly("object_pose", [](const PyExploration& e) { return pose_array(e.object_pose); })
+      .def_property_readonly("object_pose",
+                             [](const PyExploration& e) { return pose_array(e.object_pose); })
       .def_property_readonly(
           "times",
           [](const PyExploration& e) {
             py::array_t<double> out(static_cast<py::ssize_t>(e.frames.size()));
-            for (std::size_t i = 0; i < e.frames.size(); ++i) out.mutable_data()[i] = e.frames[i].time;
+            for (std::size_t i = 0; i < e.frames.size(); ++i)
+              out.mutable_data()[i] = e.frames[i].time;
             return out;
           },
           "(F,) frame times [s]")
@@ -224,7 +249,8 @@ palm-grasp pressure-image synthesiser.)doc");
           "contacts",
           [](const PyExploration& e) {
             ContactList out;
-            for (const auto& f : e.frames) out.insert(out.end(), f.contacts.begin(), f.contacts.end());
+            for (const auto& f : e.frames)
+              out.insert(out.end(), f.contacts.begin(), f.contacts.end());
             return out;
           },
           "all contacts in time order (taxel.Contacts)")
@@ -234,12 +260,13 @@ palm-grasp pressure-image synthesiser.)doc");
             const std::size_t pads = pads_per_frame(e);
             const auto r = e.frames.empty() || pads == 0 ? 0 : e.frames[0].pads[0].counts.rows();
             const auto c = e.frames.empty() || pads == 0 ? 0 : e.frames[0].pads[0].counts.cols();
-            py::array_t<std::uint16_t> out({static_cast<py::ssize_t>(e.frames.size()),
-                                            static_cast<py::ssize_t>(pads), static_cast<py::ssize_t>(r),
-                                            static_cast<py::ssize_t>(c)});
+            py::array_t<std::uint16_t> out(
+                {static_cast<py::ssize_t>(e.frames.size()), static_cast<py::ssize_t>(pads),
+                 static_cast<py::ssize_t>(r), static_cast<py::ssize_t>(c)});
             std::uint16_t* o = out.mutable_data();
             for (const auto& f : e.frames) {
-              for (const auto& p : f.pads) o = std::copy(p.counts.data(), p.counts.data() + p.counts.size(), o);
+              for (const auto& p : f.pads)
+                o = std::copy(p.counts.data(), p.counts.data() + p.counts.size(), o);
             }
             return out;
           },
@@ -271,9 +298,12 @@ palm-grasp pressure-image synthesiser.)doc");
          double heading_sigma, const sensor::SensorModel& sensor,
          const sensor::ContactOptions& contacts, double frame_rate, double indentation,
          const std::optional<ArrayD>& object_pose, std::uint64_t seed) {
-        const auto cfg = exploration_config(sensor, contacts, frame_rate, indentation, object_pose, seed);
+        const auto cfg =
+            exploration_config(sensor, contacts, frame_rate, indentation, object_pose, seed);
         const sm::SlideParams p{slides, frames, speed, heading_sigma};
-        return explore(shape, cfg, [&](const auto& sh, const auto& c) { return sm::explore_sliding(sh, c, p); });
+        return explore(shape, cfg, [&](const auto& sh, const auto& c) {
+          return sm::explore_sliding(sh, c, p);
+        });
       },
       py::arg("shape"), py::kw_only(), py::arg("slides") = 4, py::arg("frames") = 1000,
       py::arg("speed") = 0.05, py::arg("heading_sigma") = 0.05, TAXEL_EXPLORATION_ARGS,
@@ -284,13 +314,16 @@ palm-grasp pressure-image synthesiser.)doc");
          double closing_speed, int hold_frames, const sensor::SensorModel& sensor,
          const sensor::ContactOptions& contacts, double frame_rate, double indentation,
          const std::optional<ArrayD>& object_pose, std::uint64_t seed) {
-        const auto cfg = exploration_config(sensor, contacts, frame_rate, indentation, object_pose, seed);
-        const sm::GraspParams p{grasps, fingers, pads_per_finger, pad_spacing, closing_speed, hold_frames};
-        return explore(shape, cfg, [&](const auto& sh, const auto& c) { return sm::explore_grasps(sh, c, p); });
+        const auto cfg =
+            exploration_config(sensor, contacts, frame_rate, indentation, object_pose, seed);
+        const sm::GraspParams p{grasps,      fingers,       pads_per_finger,
+                                pad_spacing, closing_speed, hold_frames};
+        return explore(shape, cfg,
+                       [&](const auto& sh, const auto& c) { return sm::explore_grasps(sh, c, p); });
       },
       py::arg("shape"), py::kw_only(), py::arg("grasps") = 8, py::arg("fingers") = 3,
-      py::arg("pads_per_finger") = 2, py::arg("pad_spacing") = 0.05, py::arg("closing_speed") = 0.05,
-      py::arg("hold_frames") = 50, TAXEL_EXPLORATION_ARGS,
+      py::arg("pads_per_finger") = 2, py::arg("pad_spacing") = 0.05,
+      py::arg("closing_speed") = 0.05, py::arg("hold_frames") = 50, TAXEL_EXPLORATION_ARGS,
       "Closes a hand of fingers x pads_per_finger pads on the shape `grasps` times.");
   m.def(
       "explore_palpation",
@@ -298,9 +331,12 @@ palm-grasp pressure-image synthesiser.)doc");
          const sensor::SensorModel& sensor, const sensor::ContactOptions& contacts,
          double frame_rate, double indentation, const std::optional<ArrayD>& object_pose,
          std::uint64_t seed) {
-        const auto cfg = exploration_config(sensor, contacts, frame_rate, indentation, object_pose, seed);
+        const auto cfg =
+            exploration_config(sensor, contacts, frame_rate, indentation, object_pose, seed);
         const sm::PalpationParams p{touches, press_speed, hold_frames};
-        return explore(shape, cfg, [&](const auto& sh, const auto& c) { return sm::explore_palpation(sh, c, p); });
+        return explore(shape, cfg, [&](const auto& sh, const auto& c) {
+          return sm::explore_palpation(sh, c, p);
+        });
       },
       py::arg("shape"), py::kw_only(), py::arg("touches") = 40, py::arg("press_speed") = 0.02,
       py::arg("hold_frames") = 10, TAXEL_EXPLORATION_ARGS,
@@ -333,7 +369,8 @@ Synthetic palm pressure images (rows x cols, 0..255) of four grasp classes: 1 pl
             py::array_t<bool> right(n);
             for (py::ssize_t i = 0; i < n; ++i) {
               const auto& x = d[static_cast<std::size_t>(i)];
-              std::copy(x.image.data(), x.image.data() + x.image.size(), images.mutable_data() + i * r * c);
+              std::copy(x.image.data(), x.image.data() + x.image.size(),
+                        images.mutable_data() + i * r * c);
               labels.mutable_data()[i] = static_cast<int>(x.label);
               subject.mutable_data()[i] = x.subject;
               right.mutable_data()[i] = x.right_hand;

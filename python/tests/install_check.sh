@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Installs the Python package the two documented ways and runs a short session with each:
+#   cmake --install <build> --component python --prefix <dir>
+#   python3 -m venv --system-site-packages <venv> && <venv>/bin/pip install --no-build-isolation <src>
+# Usage: install_check.sh cmake|pip PYTHON BUILD_DIR SOURCE_DIR SITE_RELATIVE WORK_DIR
+set -euo pipefail
+how=$1 python=$2 build=$3 src=$4 site=$5 work=$6
+rm -rf "$work" && mkdir -p "$work"
+session='
+import sys, numpy as np, taxel
+from taxel import fusion, registration, sim
+assert taxel.__file__.startswith(sys.argv[1]), taxel.__file__
+cloud = fusion.ContactCloud("kalman")
+cloud.insert(sim.Sphere(0.03).sample_surface(500, 1).points, sigma=2e-4)
+assert 0 < len(cloud) < 500
+print("taxel", taxel.__version__, "from", taxel.__file__, ":", cloud)
+'
+case "$how" in
+  cmake)
+    cmake --install "$build" --component python --prefix "$work/prefix" >/dev/null
+    cd "$work" && PYTHONPATH="$work/prefix/$site" "$python" -c "$session" "$work/prefix"
+    ;;
+  pip)
+    "$python" -m venv --system-site-packages "$work/venv"
+    # A copy of the sources, so that the build leaves nothing in the checkout.
+    mkdir -p "$work/src" && (cd "$src" && git ls-files -z | xargs -0 cp --parents -t "$work/src")
+    CMAKE_BUILD_PARALLEL_LEVEL=${CMAKE_BUILD_PARALLEL_LEVEL:-2} \
+      "$work/venv/bin/pip" install --no-build-isolation --no-deps -q "$work/src" >"$work/pip.log" 2>&1 \
+      || { tail -n 40 "$work/pip.log"; exit 1; }
+    cd "$work" && "$work/venv/bin/python" -c "$session" "$work/venv"
+    ;;
+  *) echo "install_check.sh: cmake or pip, not '$how'" >&2; exit 2 ;;
+esac
