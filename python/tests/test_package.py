@@ -81,3 +81,12 @@ def test_examples_run(tmp_path):
                              text=True, env=env, timeout=300)
         assert run.returncode == 0, f"{script.name}: {run.stderr}"
         assert run.stdout.strip(), script.name
+
+
+def test_readme_session_runs(tmp_path):
+    readme = (PACKAGE.parents[1] / "README.md").read_text()
+    block = re.search(r"```python\n(.*?)```", readme, re.S).group(1)
+    run = subprocess.run([sys.executable, "-W", "ignore", "-c", block], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / "grasp.model").read_text().startswith("solver_type L2R_L2LOSS_SVC_DUAL")
