@@ -14,11 +14,14 @@ import numpy as np
 import taxel
 
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "taxel"
+# Child processes import the package under test, wherever the working directory is.
+ENV = dict(os.environ, PYTHONPATH=str(pathlib.Path(taxel.__file__).resolve().parents[1]))
 
 
 def test_stubs_are_current_and_parse():
     tool = PACKAGE.parent / "tools" / "stubgen.py"
-    run = subprocess.run([sys.executable, str(tool), "--check", str(PACKAGE)], capture_output=True, text=True)
+    run = subprocess.run([sys.executable, str(tool), "--check", str(PACKAGE)], capture_output=True, text=True,
+                         env=ENV)
     assert run.returncode == 0, run.stderr
     for stub in PACKAGE.glob("*.pyi"):
         ast.parse(stub.read_text())
@@ -73,7 +76,7 @@ def test_long_calls_release_the_gil():
 
 def test_examples_run(tmp_path):
     examples = PACKAGE.parents[1] / "examples" / "python"
-    env = dict(os.environ, MPLBACKEND="Agg", TAXEL_EXAMPLE_QUICK="1")
+    env = dict(ENV, MPLBACKEND="Agg", TAXEL_EXAMPLE_QUICK="1")
     scripts = sorted(examples.glob("*.py"))
     assert len(scripts) >= 2
     for script in scripts:
@@ -87,6 +90,6 @@ def test_readme_session_runs(tmp_path):
     readme = (PACKAGE.parents[1] / "README.md").read_text()
     block = re.search(r"```python\n(.*?)```", readme, re.S).group(1)
     run = subprocess.run([sys.executable, "-W", "ignore", "-c", block], cwd=tmp_path, capture_output=True,
-                         text=True, timeout=300)
+                         text=True, timeout=300, env=ENV)
     assert run.returncode == 0, run.stderr
     assert (tmp_path / "grasp.model").read_text().startswith("solver_type L2R_L2LOSS_SVC_DUAL")
