@@ -92,25 +92,29 @@ inline std::vector<Vec3d> points_from(const ArrayD& a, const char* what) {
   return out;
 }
 
-/// A 4x4 homogeneous matrix as an isometry. Throws ValueError unless it is finite, its last row
-/// is (0, 0, 0, 1) and its rotation is orthonormal with determinant +1 (to 1e-6).
+/// Why the row-major 4x4 matrix at `m` is not a rigid transform (finite, last row (0, 0, 0, 1),
+/// an orthonormal rotation with determinant +1 to 1e-6), or nullptr when it is; `t` receives it.
+inline const char* rigid_defect(const double* m, Isometry3d& t) {
+  const Eigen::Matrix4d a = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(m);
+  if (!a.allFinite()) return "the matrix is not finite";
+  if ((a.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9) {
+    return "the last row must be (0, 0, 0, 1)";
+  }
+  const Mat3d r = a.topLeftCorner<3, 3>();
+  if ((r.transpose() * r - Mat3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || r.determinant() < 0) {
+    return "the upper-left 3x3 block is not a rotation";
+  }
+  t.matrix() = a;
+  return nullptr;
+}
+
+/// A 4x4 homogeneous matrix as an isometry; ValueError naming `what` unless it is rigid.
 inline Isometry3d pose_from(const ArrayD& a, const char* what) {
   require_shape(a, {4, 4}, what, "(4, 4)");
-  Eigen::Matrix4d m;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) m(r, c) = a.data()[r * 4 + c];
-  }
-  const std::string who(what);
-  if (!m.allFinite()) throw py::value_error(who + ": the matrix is not finite");
-  if ((m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9) {
-    throw py::value_error(who + ": the last row must be (0, 0, 0, 1)");
-  }
-  const Mat3d r = m.topLeftCorner<3, 3>();
-  if ((r.transpose() * r - Mat3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || r.determinant() < 0) {
-    throw py::value_error(who + ": the upper-left 3x3 block is not a rotation");
-  }
   Isometry3d t = Isometry3d::Identity();
-  t.matrix() = m;
+  if (const char* why = rigid_defect(a.data(), t)) {
+    throw py::value_error(std::string(what) + ": " + why);
+  }
   return t;
 }
 

@@ -243,10 +243,10 @@ ContactList readings_to_contacts(const ArrayU16& readings, const ArrayD& poses,
       pose.frame = f;
       pose.pad = p;
       if (times) pose.time = times->data()[f];
-      const ArrayD one({4, 4}, m);
-      pose.pose = pose_from(
-          one,
-          ("poses[" + std::to_string(f) + (one_pad ? "" : ", " + std::to_string(p)) + "]").c_str());
+      if (const char* why = rigid_defect(m, pose.pose)) {
+        throw py::value_error("poses[" + std::to_string(f) +
+                              (one_pad ? "" : ", " + std::to_string(p)) + "]: " + why);
+      }
       list.push_back(pose);
     }
   }
