@@ -51,3 +51,5 @@ class TaxelConan(ConanFile):
         self.cpp_info.set_property("pkg_config_name", "taxel")
         self.cpp_info.bindirs = []
         self.cpp_info.libdirs = []
+        if self.settings.os in ("Linux", "FreeBSD"):
+            self.cpp_info.system_libs = ["pthread"]  # <taxel/core/parallel.hpp> uses std::jthread

@@ -266,7 +266,8 @@ files.)doc");
   m.def(
       "cross_validate",
       [](const py::object& model, ArrayD x, ArrayI y, std::optional<ArrayI> groups, int folds,
-         std::uint64_t seed, bool grouped, double snr_db, const std::string& noise_target) {
+         std::uint64_t seed, bool grouped, double snr_db, const std::string& noise_target,
+         unsigned threads) {
         const DataArrays d = data_arrays(std::move(x), std::move(y), std::move(groups));
         ln::CvOptions opt;
         opt.folds = folds;
@@ -274,6 +275,7 @@ files.)doc");
         opt.grouped = grouped;
         opt.snr_db = snr_db;
         opt.noise_target = enum_from(noise_target, kNoiseTargets, "noise_target");
+        opt.threads = threads;
         ln::CvReport r = with_classifier(model, [&](const auto& c) {
           py::gil_scoped_release release;
           return ln::cross_validate(c, d.view(), opt);
@@ -285,9 +287,10 @@ files.)doc");
       py::arg("model"), py::arg("X"), py::arg("y"), py::arg("groups") = py::none(), py::kw_only(),
       py::arg("folds") = 5, py::arg("seed") = 1, py::arg("grouped") = false,
       py::arg("snr_db") = std::numeric_limits<double>::infinity(),
-      py::arg("noise_target") = "test_only",
+      py::arg("noise_target") = "test_only", py::arg("threads") = 0,
       "Stratified k-fold cross-validation of an (unfitted) classifier; grouped keeps each "
-      "group in one fold; snr_db adds white noise to the test (or both) features.");
+      "group in one fold; snr_db adds white noise to the test (or both) features. The folds "
+      "train on `threads` threads (0: every core); the report does not depend on it.");
 
   py::class_<ln::FiveByTwoResult>(m, "FiveByTwoResult", "Dietterich's 5x2cv paired t test.")
       .def_property_readonly(
@@ -328,7 +331,7 @@ files.)doc");
       "five_by_two_cv",
       [](const py::object& a, const py::object& b, ArrayD x, ArrayI y, std::optional<ArrayI> groups,
          double alpha, std::uint64_t seed, bool grouped, double snr_db,
-         const std::string& noise_target) {
+         const std::string& noise_target, unsigned threads) {
         const DataArrays d = data_arrays(std::move(x), std::move(y), std::move(groups));
         ln::FiveByTwoOptions opt;
         opt.alpha = alpha;
@@ -336,6 +339,7 @@ files.)doc");
         opt.grouped = grouped;
         opt.snr_db = snr_db;
         opt.noise_target = enum_from(noise_target, kNoiseTargets, "noise_target");
+        opt.threads = threads;
         ln::FiveByTwoResult r = with_classifier(a, [&](const auto& ca) {
           return with_classifier(b, [&](const auto& cb) {
             py::gil_scoped_release release;
@@ -348,8 +352,9 @@ files.)doc");
       py::arg("a"), py::arg("b"), py::arg("X"), py::arg("y"), py::arg("groups") = py::none(),
       py::kw_only(), py::arg("alpha") = 0.05, py::arg("seed") = 1, py::arg("grouped") = false,
       py::arg("snr_db") = std::numeric_limits<double>::infinity(),
-      py::arg("noise_target") = "test_only",
-      "Dietterich's 5x2cv paired t test of two (unfitted) classifiers on the same splits.");
+      py::arg("noise_target") = "test_only", py::arg("threads") = 0,
+      "Dietterich's 5x2cv paired t test of two (unfitted) classifiers on the same splits; the "
+      "ten rounds run on `threads` threads (0: every core).");
 
   m.def(
       "read_libsvm",

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
 // Tests of taxel/core: contact covariance helpers, validation, status, assertions, errors.
 #include <Eigen/Eigenvalues>
+#include <atomic>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <taxel/core.hpp>
+#include <taxel/core/parallel.hpp>
 
 using Catch::Matchers::Contains;
 
@@ -181,4 +184,29 @@ TEST_CASE("PointCloud validates its size invariants and transforms points and no
 
 TEST_CASE("the version header matches the CMake project version") {
   CHECK(std::string(TAXEL_VERSION_STRING) == TAXEL_EXPECTED_VERSION);
+}
+
+TEST_CASE("parallel_for calls every item once and rethrows the lowest failing item",
+          "[core][threads]") {
+  for (const unsigned threads : {0u, 1u, 2u, 7u}) {
+    std::vector<int> hits(1000, 0);
+    taxel::parallel_for(hits.size(), threads, [&](std::size_t i) { hits[i] += 1; });
+    CHECK(std::count(hits.begin(), hits.end(), 1) == 1000);
+  }
+  taxel::parallel_for(0, 4, [](std::size_t) { FAIL("no item"); });
+  // Items 3 and 5 throw; whichever thread meets which first, item 3's exception comes out when
+  // it ran, and no item runs twice.
+  std::vector<std::atomic<int>> ran(50);
+  try {
+    taxel::parallel_for(ran.size(), 2, [&](std::size_t i) {
+      ran[i].fetch_add(1);
+      if (i == 3 || i == 5) throw std::runtime_error("item " + std::to_string(i));
+    });
+    FAIL("no exception");
+  } catch (const std::runtime_error& e) {
+    CHECK(std::string(e.what()) == "item 3");
+  }
+  for (const auto& r : ran) CHECK(r.load() <= 1);
+  CHECK(taxel::resolve_threads(3) == 3);
+  CHECK(taxel::resolve_threads(0) >= 1);
 }

@@ -10,12 +10,14 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "taxel/core/parallel.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/concepts.hpp"
 #include "taxel/learn/dataset.hpp"
@@ -102,7 +104,10 @@ struct CvOptions {
   bool grouped = false;    ///< keep each group (DatasetView::groups) in one fold
   double snr_db = std::numeric_limits<double>::infinity();  ///< feature noise; inf = none
   NoiseTarget noise_target = NoiseTarget::test_only;        ///< where the noise goes
-  ProgressFn progress{};                                    ///< called after each fold
+  /// Folds trained at once, each on its own thread (0: every core). The report does not depend
+  /// on it: the noise is drawn in fold order before training.
+  unsigned threads = 0;
+  ProgressFn progress{};  ///< called after each fold (from the thread that ran it, serialised)
 };
 
 /// Cross-validated accuracy.
@@ -116,27 +121,61 @@ struct CvReport : Outcome {
 };
 
 namespace detail {
-template <Classifier C>
-Outcome train_and_test(const C& prototype, const DatasetView& d, std::span<const int> fold, int f,
-                       double snr_db, NoiseTarget target, std::mt19937_64& rng,
-                       std::vector<int>& predicted) {
+
+/// One train/test split, its noise already added: what a fold needs to run on its own thread.
+struct Split {
+  Dataset train, test;
+  std::vector<std::size_t> test_rows;  ///< the test samples' rows in the full data set
+};
+
+/// The split of fold `f` (test) against the other folds (train), with feature noise drawn from
+/// `rng` when snr_db is finite: the test features, and the training features too for `both`.
+template <class = void>
+Split make_split(const DatasetView& d, std::span<const int> fold, int f, double snr_db,
+                 NoiseTarget target, std::mt19937_64& rng) {
   std::vector<std::size_t> train;
-  std::vector<std::size_t> test;
-  for (std::size_t i = 0; i < fold.size(); ++i) (fold[i] == f ? test : train).push_back(i);
-  Dataset tr = subset(d, train);
-  Dataset te = subset(d, test);
+  Split s;
+  for (std::size_t i = 0; i < fold.size(); ++i) (fold[i] == f ? s.test_rows : train).push_back(i);
+  s.train = subset(d, train);
+  s.test = subset(d, s.test_rows);
   if (std::isfinite(snr_db)) {
-    if (target == NoiseTarget::both) add_white_noise(tr.x, snr_db, rng);
-    add_white_noise(te.x, snr_db, rng);
+    if (target == NoiseTarget::both) add_white_noise(s.train.x, snr_db, rng);
+    add_white_noise(s.test.x, snr_db, rng);
   }
+  return s;
+}
+
+/// Trains a copy of `prototype` on the split and writes its test predictions to
+/// predicted[test row]. Returns the training outcome.
+template <Classifier C>
+Outcome train_and_test(const C& prototype, const Split& s, std::vector<int>& predicted) {
   C model = prototype;
-  Outcome o = model.fit(tr.view());
+  Outcome o = model.fit(s.train.view());
   if (o.status != Status::ok && o.status != Status::not_converged) return o;
-  for (std::size_t r = 0; r < test.size(); ++r) {
-    predicted[test[r]] = model.predict(te.x.row(static_cast<Eigen::Index>(r)).transpose());
+  for (std::size_t r = 0; r < s.test_rows.size(); ++r) {
+    predicted[s.test_rows[r]] =
+        model.predict(s.test.x.row(static_cast<Eigen::Index>(r)).transpose());
   }
   return o;
 }
+
+/// Calls progress(done, total) after each unit, one call at a time, from any thread.
+class Progress {
+ public:
+  Progress(const ProgressFn& fn, std::size_t total) : fn_(fn), total_(total) {}
+  void step() {
+    if (!fn_) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    fn_(++done_, total_);
+  }
+
+ private:
+  const ProgressFn& fn_;
+  std::size_t total_;
+  std::size_t done_ = 0;
+  std::mutex mutex_;
+};
+
 }  // namespace detail
 
 /// K-fold cross-validation of a copy of `prototype` (trained afresh on each fold). A fold whose
@@ -164,10 +203,29 @@ CvReport cross_validate(const C& prototype, const DatasetView& d, const CvOption
   rep.fold = std::move(folds.value);
   rep.classes = class_order(d.y);
   rep.predicted.assign(d.y.size(), 0);
+  // Noise is drawn in fold order from one generator, so the splits (and the report) are the
+  // same for any number of threads; the folds then train in parallel. Without noise each fold
+  // makes its own split on its thread.
+  const bool noisy = std::isfinite(opt.snr_db);
   std::mt19937_64 rng(opt.seed ^ 0x9e3779b97f4a7c15ULL);
-  for (int f = 0; f < opt.folds; ++f) {
-    const Outcome o = detail::train_and_test(prototype, d, rep.fold, f, opt.snr_db,
-                                             opt.noise_target, rng, rep.predicted);
+  std::vector<detail::Split> splits(static_cast<std::size_t>(opt.folds));
+  for (int f = 0; noisy && f < opt.folds; ++f) {
+    splits[static_cast<std::size_t>(f)] =
+        detail::make_split(d, rep.fold, f, opt.snr_db, opt.noise_target, rng);
+  }
+  std::vector<Outcome> outcomes(splits.size());
+  detail::Progress progress(opt.progress, splits.size());
+  parallel_for(splits.size(), opt.threads, [&](std::size_t f) {
+    if (!noisy) {
+      splits[f] = detail::make_split(d, rep.fold, static_cast<int>(f), opt.snr_db, opt.noise_target,
+                                     rng);  // draws nothing without noise
+    }
+    outcomes[f] = detail::train_and_test(prototype, splits[f], rep.predicted);
+    splits[f] = {};  // free the fold's copy of the data as soon as it is done
+    progress.step();
+  });
+  for (std::size_t f = 0; f < outcomes.size(); ++f) {
+    const Outcome& o = outcomes[f];
     if (o.status == Status::not_converged && rep.ok()) {
       rep.status = o.status;
       rep.message = "fold " + std::to_string(f + 1) + ": " + o.message;
@@ -176,8 +234,6 @@ CvReport cross_validate(const C& prototype, const DatasetView& d, const CvOption
       rep.message = "fold " + std::to_string(f + 1) + ": " + o.message;
       return rep;
     }
-    if (opt.progress)
-      opt.progress(static_cast<std::size_t>(f + 1), static_cast<std::size_t>(opt.folds));
   }
   const auto k = static_cast<Eigen::Index>(rep.classes.size());
   rep.confusion = Eigen::MatrixXi::Zero(k, k);
@@ -204,7 +260,8 @@ struct FiveByTwoOptions {
   bool grouped = false;    ///< keep each group in one half
   double snr_db = std::numeric_limits<double>::infinity();  ///< feature noise; inf = none
   NoiseTarget noise_target = NoiseTarget::test_only;        ///< where the noise goes
-  ProgressFn progress{};  ///< called after each of the 10 train/test rounds
+  unsigned threads = 0;   ///< rounds run at once, each on its own thread (0: every core)
+  ProgressFn progress{};  ///< called after each of the 10 train/test rounds (serialised)
 };
 
 /// Dietterich's 5x2cv paired t test: five replications of a stratified 2-fold split; both
@@ -220,51 +277,60 @@ FiveByTwoResult five_by_two_cv(const A& a, const B& b, const DatasetView& d,
     static_cast<Outcome&>(fail) = check;
     return fail;
   }
+  // The ten rounds (5 replications x 2 folds) are independent: each has its own split and its
+  // own noise generator, so they run in parallel with results independent of the thread count.
+  std::vector<std::vector<int>> folds(5);
+  for (int rep = 0; rep < 5; ++rep) {
+    auto f = kfold_assignment(d.y, 2, opt.seed + static_cast<std::uint64_t>(rep) * 7919U,
+                              opt.grouped ? d.groups : std::span<const int>{});
+    if (!f) {
+      static_cast<Outcome&>(fail) = f;
+      return fail;
+    }
+    folds[static_cast<std::size_t>(rep)] = std::move(f.value);
+  }
+  struct Round {
+    Outcome a, b;
+    double error_a = 0.0, error_b = 0.0;
+  };
+  std::vector<Round> rounds(10);
+  detail::Progress progress(opt.progress, rounds.size());
+  parallel_for(rounds.size(), opt.threads, [&](std::size_t k) {
+    const int rep = static_cast<int>(k / 2);
+    const int f = static_cast<int>(k % 2);
+    const std::vector<int>& fold = folds[static_cast<std::size_t>(rep)];
+    // Both classifiers see the same noisy features.
+    std::mt19937_64 noise(opt.seed * 31U + static_cast<std::uint64_t>(rep * 2 + f));
+    const detail::Split split = detail::make_split(d, fold, f, opt.snr_db, opt.noise_target, noise);
+    std::vector<int> pred_a(d.y.size()), pred_b(d.y.size());
+    Round& r = rounds[k];
+    r.a = detail::train_and_test(a, split, pred_a);
+    r.b = detail::train_and_test(b, split, pred_b);
+    std::size_t wrong_a = 0, wrong_b = 0;
+    for (const std::size_t i : split.test_rows) {
+      wrong_a += pred_a[i] != d.y[i] ? 1 : 0;
+      wrong_b += pred_b[i] != d.y[i] ? 1 : 0;
+    }
+    const auto n_test = static_cast<double>(split.test_rows.size());
+    r.error_a = static_cast<double>(wrong_a) / n_test;
+    r.error_b = static_cast<double>(wrong_b) / n_test;
+    progress.step();
+  });
   FiveByTwoDifferences diff{};
   double err_a = 0.0;
   double err_b = 0.0;
-  std::vector<int> pred_a(d.y.size());
-  std::vector<int> pred_b(d.y.size());
-  std::size_t round = 0;
-  for (int rep = 0; rep < 5; ++rep) {
-    auto folds = kfold_assignment(d.y, 2, opt.seed + static_cast<std::uint64_t>(rep) * 7919U,
-                                  opt.grouped ? d.groups : std::span<const int>{});
-    if (!folds) {
-      static_cast<Outcome&>(fail) = folds;
-      return fail;
-    }
-    for (int f = 0; f < 2; ++f) {
-      // Same noise for both: one generator state per round, copied.
-      std::mt19937_64 noise(opt.seed * 31U + static_cast<std::uint64_t>(rep * 2 + f));
-      std::mt19937_64 noise_b = noise;
-      const Outcome oa =
-          detail::train_and_test(a, d, folds.value, f, opt.snr_db, opt.noise_target, noise, pred_a);
-      const Outcome ob = detail::train_and_test(b, d, folds.value, f, opt.snr_db, opt.noise_target,
-                                                noise_b, pred_b);
-      for (const Outcome* o : {&oa, &ob}) {
-        if (!*o && o->status != Status::not_converged) {
-          static_cast<Outcome&>(fail) = *o;
-          fail.message = "replication " + std::to_string(rep + 1) + ", fold " +
-                         std::to_string(f + 1) + ": " + o->message;
-          return fail;
-        }
+  for (std::size_t k = 0; k < rounds.size(); ++k) {
+    for (const Outcome* o : {&rounds[k].a, &rounds[k].b}) {
+      if (!*o && o->status != Status::not_converged) {
+        static_cast<Outcome&>(fail) = *o;
+        fail.message = "replication " + std::to_string(k / 2 + 1) + ", fold " +
+                       std::to_string(k % 2 + 1) + ": " + o->message;
+        return fail;
       }
-      std::size_t n_test = 0;
-      std::size_t wrong_a = 0;
-      std::size_t wrong_b = 0;
-      for (std::size_t i = 0; i < d.y.size(); ++i) {
-        if (folds.value[i] != f) continue;
-        ++n_test;
-        wrong_a += pred_a[i] != d.y[i] ? 1 : 0;
-        wrong_b += pred_b[i] != d.y[i] ? 1 : 0;
-      }
-      const double ea = static_cast<double>(wrong_a) / static_cast<double>(n_test);
-      const double eb = static_cast<double>(wrong_b) / static_cast<double>(n_test);
-      diff[static_cast<std::size_t>(rep)][static_cast<std::size_t>(f)] = ea - eb;
-      err_a += ea / 10.0;
-      err_b += eb / 10.0;
-      if (opt.progress) opt.progress(++round, 10);
     }
+    diff[k / 2][k % 2] = rounds[k].error_a - rounds[k].error_b;
+    err_a += rounds[k].error_a / 10.0;
+    err_b += rounds[k].error_b / 10.0;
   }
   FiveByTwoResult r = five_by_two_t_test(diff, opt.alpha);
   r.mean_error_a = err_a;
