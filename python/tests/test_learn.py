@@ -134,3 +134,13 @@ def test_errors(tmp_path, rng):
         learn.LinearSvm.load(str(tmp_path / "missing.txt"))
     with pytest.raises(OSError):
         svm.save(str(tmp_path / "no" / "such" / "dir" / "m.txt"))
+
+
+def test_threads_do_not_change_results(rng):
+    x, y = blobs(rng, n=90, spread=2.5)
+    one = learn.cross_validate(learn.Mlp(epochs=20), x, y, folds=5, snr_db=5.0, threads=1)
+    two = learn.cross_validate(learn.Mlp(epochs=20), x, y, folds=5, snr_db=5.0, threads=2)
+    np.testing.assert_array_equal(one.predicted, two.predicted)
+    a = learn.five_by_two_cv(learn.LinearSvm(), learn.Knn(), x, y, threads=1)
+    b = learn.five_by_two_cv(learn.LinearSvm(), learn.Knn(), x, y, threads=2)
+    np.testing.assert_array_equal(a.differences, b.differences)
