@@ -153,6 +153,24 @@ BENCHMARK(BM_WholeChain)
     ->Arg(1)
     ->ArgName("palm_grasps");
 
+// A stack of 1 000 palm-grasp images through recognize_all on 1 thread and on every core
+// (arg: threads, 0 = all), the trained SVM included.
+void BM_RecognizeStack(benchmark::State& state) {
+  const ti::Recognizer<ti::GradientThreshold, taxel::learn::LinearSvm> rec(32, 32, {}, {},
+                                                                           trained_svm());
+  const std::vector<ti::ImageD>& imgs = palm_grasps();
+  const std::size_t n = 1000;
+  const auto threads = static_cast<unsigned>(state.range(0));
+  for (auto _ : state) {
+    const auto all = ti::recognize_all(
+        rec, n, [&](std::size_t i) -> const ti::ImageD& { return imgs[i % imgs.size()]; }, threads);
+    benchmark::DoNotOptimize(all.back().label);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
+  state.counters["threads"] = taxel::resolve_threads(threads);
+}
+BENCHMARK(BM_RecognizeStack)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -403,34 +403,34 @@ gradient_threshold) and the feature vectors.)doc")
           py::arg("image"), "Runs the chain on one image; ValueError for a wrong size or NaN.")
       .def(
           "features",
-          [](PyRecognizer& r, const ArrayD& images) {
+          [](const PyRecognizer& r, const ArrayD& images, unsigned threads) {
             const Frames f = frames_of(images, "features");
             const auto n = f.frames;
+            std::vector<im::Recognition> all;
+            {
+              py::gil_scoped_release release;
+              all = im::recognize_all(
+                  r.recognizer, static_cast<std::size_t>(n),
+                  [&](std::size_t i) { return frame(images, f, static_cast<py::ssize_t>(i)); },
+                  threads);
+            }
             ArrayD regional({n, py::ssize_t{im::kRegionalFeatures}});
             ArrayD edge({n, py::ssize_t{im::kEdgeFeatures}});
             ArrayD hybrid({n, f.rows * f.cols + im::kRegionalFeatures});
             py::array_t<bool> edged(n);
             ArrayD gm(n);
-            std::string error;
-            {
-              py::gil_scoped_release release;
-              for (py::ssize_t i = 0; i < n && error.empty(); ++i) {
-                const im::Recognition& x = r.recognizer.recognize(frame(images, f, i));
-                if (!x.ok()) {
-                  error = "frame " + std::to_string(i) + ": " + x.message;
-                  break;
-                }
-                std::copy_n(x.regional.data(), x.regional.size(),
-                            regional.mutable_data() + i * x.regional.size());
-                std::copy_n(x.edge_features.data(), x.edge_features.size(),
-                            edge.mutable_data() + i * x.edge_features.size());
-                std::copy_n(x.hybrid.data(), x.hybrid.size(),
-                            hybrid.mutable_data() + i * x.hybrid.size());
-                edged.mutable_data()[i] = x.edged;
-                gm.mutable_data()[i] = x.contour_gradient;
-              }
+            for (py::ssize_t i = 0; i < n; ++i) {
+              const im::Recognition& x = all[static_cast<std::size_t>(i)];
+              if (!x.ok()) throw py::value_error("frame " + std::to_string(i) + ": " + x.message);
+              std::copy_n(x.regional.data(), x.regional.size(),
+                          regional.mutable_data() + i * x.regional.size());
+              std::copy_n(x.edge_features.data(), x.edge_features.size(),
+                          edge.mutable_data() + i * x.edge_features.size());
+              std::copy_n(x.hybrid.data(), x.hybrid.size(),
+                          hybrid.mutable_data() + i * x.hybrid.size());
+              edged.mutable_data()[i] = x.edged;
+              gm.mutable_data()[i] = x.contour_gradient;
             }
-            if (!error.empty()) throw py::value_error(error);
             py::dict d;
             d["regional"] = regional;
             d["edge"] = edge;
@@ -439,9 +439,11 @@ gradient_threshold) and the feature vectors.)doc")
             d["contour_gradient"] = gm;
             return d;
           },
-          py::arg("images"),
+          py::arg("images"), py::kw_only(), py::arg("threads") = 0,
           "Features of an image or a stack: a dict of 'regional' (F, 11), 'edge' (F, 23), "
-          "'hybrid' (F, rows*cols + 11), 'edged' (F,) and 'contour_gradient' (F,).");
+          "'hybrid' (F, rows*cols + 11), 'edged' (F,) and 'contour_gradient' (F,). Frames are "
+          "shared out over `threads` threads (0: every core), each with its own copy of the "
+          "recogniser; the result does not depend on it.");
 }
 
 }  // namespace taxel::python

@@ -62,7 +62,7 @@ class Recognizer:
 gradients, the edged/edgeless decision (mean contour gradient of the largest HPR above
 gradient_threshold) and the feature vectors."""
     def __init__(self, rows: int = 32, cols: int = 32, *, gradient_threshold: float = 25.0, gradient_source: str = 'raw', k: int = 3, polarity: str = 'high_is_pressure', min_area: int = 50, connectivity: int = 8) -> None: ...
-    def features(self, images: numpy.typing.NDArray[numpy.float64]) -> dict: """Features of an image or a stack: a dict of 'regional' (F, 11), 'edge' (F, 23), 'hybrid' (F, rows*cols + 11), 'edged' (F,) and 'contour_gradient' (F,)."""
+    def features(self, images: numpy.typing.NDArray[numpy.float64], *, threads: int = 0) -> dict: """Features of an image or a stack: a dict of 'regional' (F, 11), 'edge' (F, 23), 'hybrid' (F, rows*cols + 11), 'edged' (F,) and 'contour_gradient' (F,). Frames are shared out over `threads` threads (0: every core), each with its own copy of the recogniser; the result does not depend on it."""
     def recognize(self, image: numpy.typing.NDArray[numpy.float64]) -> taxel.image.Recognition: """Runs the chain on one image; ValueError for a wrong size or NaN."""
 
 

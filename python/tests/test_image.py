@@ -169,3 +169,12 @@ def test_recognizer_features_agree_with_the_parts():
         np.testing.assert_array_equal(f["hybrid"][i, 1024:], f["regional"][i])
     with pytest.raises(ValueError):
         rec.recognize(np.zeros((16, 16)))
+
+
+def test_features_on_threads_equal_one_thread():
+    images = sim.PalmGraspSynth(seed=9).dataset(2, 3)["images"]
+    rec = image.Recognizer()
+    one = rec.features(images, threads=1)
+    many = rec.features(images, threads=3)
+    for key in one:
+        np.testing.assert_array_equal(one[key], many[key])

@@ -795,3 +795,37 @@ TEST_CASE("Image types refuse negative and huge sizes before allocating", "[imag
   // The largest legal size still works for a tiny image.
   CHECK_NOTHROW(ti::Recognizer<>(1, 1));
 }
+
+TEST_CASE("recognize_all on several threads equals one Recognizer run in order",
+          "[image][threads]") {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 255.0);
+  std::vector<ti::ImageD> imgs;
+  for (int k = 0; k < 23; ++k) {  // blobs of varying size and place on noise
+    ti::ImageD img(32, 32);
+    for (Eigen::Index r = 0; r < 32; ++r) {
+      for (Eigen::Index c = 0; c < 32; ++c) {
+        const double d =
+            std::hypot(static_cast<double>(r - 8 - k % 11), static_cast<double>(c - 10 - k % 7));
+        img(r, c) = (d < 4.0 + k % 5 ? 200.0 : 10.0) + 0.05 * u(rng);
+      }
+    }
+    imgs.push_back(img);
+  }
+  imgs[7](3, 3) = std::numeric_limits<double>::quiet_NaN();  // one failure, kept in its slot
+  const ti::Recognizer<> proto(32, 32);
+  ti::Recognizer<> seq = proto;
+  const auto at = [&](std::size_t i) -> const ti::ImageD& { return imgs[i]; };
+  for (const unsigned threads : {1u, 2u, 5u, 0u}) {
+    const std::vector<ti::Recognition> all = ti::recognize_all(proto, imgs.size(), at, threads);
+    REQUIRE(all.size() == imgs.size());
+    for (std::size_t i = 0; i < imgs.size(); ++i) {
+      const ti::Recognition& one = seq.recognize(imgs[i]);
+      CHECK(all[i].status == one.status);
+      CHECK(all[i].hybrid == one.hybrid);
+      CHECK(all[i].edge_features == one.edge_features);
+      CHECK(all[i].edged == one.edged);
+    }
+  }
+  CHECK(ti::recognize_all(proto, 0, at, 2).empty());
+}

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "taxel/core/parallel.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/image/components.hpp"
 #include "taxel/image/features.hpp"
@@ -229,5 +230,25 @@ class Recognizer {
   std::vector<std::uint8_t> slot_;
   Recognition result_;
 };
+
+/// Runs `prototype`'s chain on `count` images, `image_at(i)` giving image i (anything an
+/// ImageView binds to), on `threads` threads (0: every core). Each thread runs its own copy of
+/// the prototype over a contiguous range of images, so the results are those of one Recognizer
+/// run over the images in order. The classifier and decider must be safe to call from several
+/// threads at once (the shipped ones are). Returns one Recognition per image.
+template <class Decider, class Classifier, class ImageAt>
+std::vector<Recognition> recognize_all(const Recognizer<Decider, Classifier>& prototype,
+                                       std::size_t count, ImageAt&& image_at,
+                                       unsigned threads = 0) {
+  std::vector<Recognition> out(count);
+  const std::size_t chunks = std::min<std::size_t>(resolve_threads(threads), count);
+  parallel_for(chunks, threads, [&](std::size_t k) {
+    Recognizer<Decider, Classifier> rec = prototype;
+    const std::size_t begin = count * k / chunks;
+    const std::size_t end = count * (k + 1) / chunks;
+    for (std::size_t i = begin; i < end; ++i) out[i] = rec.recognize(image_at(i));
+  });
+  return out;
+}
 
 }  // namespace taxel::image
