@@ -62,6 +62,27 @@ py::array_t<T> stack_like(const Frames& f) {
   return py::array_t<T>({f.frames, f.rows, f.cols});
 }
 
+/// Two maps of every frame of an image or stack, fn(frame, a, b) filling a and b, as a tuple of
+/// two arrays shaped like the input. Runs without the GIL.
+template <class Fn>
+py::tuple two_maps(const ArrayD& image, const char* what, Fn&& fn) {
+  const Frames f = frames_of(image, what);
+  auto first = stack_like<double>(f);
+  auto second = stack_like<double>(f);
+  double* pa = first.mutable_data();
+  double* pb = second.mutable_data();
+  {
+    py::gil_scoped_release release;
+    im::ImageD a, b;
+    for (py::ssize_t i = 0; i < f.frames; ++i) {
+      fn(frame(image, f, i), a, b);
+      pa = std::copy(a.data(), a.data() + a.size(), pa);
+      pb = std::copy(b.data(), b.data() + b.size(), pb);
+    }
+  }
+  return py::make_tuple(first, second);
+}
+
 py::dict props_dict(const im::RegionProps& p) {
   py::dict d;
   d["area"] = p.area;
@@ -274,18 +295,11 @@ counter-clockwise with y up.)doc");
   m.def(
       "gradient",
       [](const ArrayD& image) {
-        const Frames f = frames_of(image, "gradient");
-        auto mag = stack_like<double>(f);
-        auto dir = stack_like<double>(f);
-        py::gil_scoped_release release;
-        im::ImageD a, b, gx, gy;
-        for (py::ssize_t i = 0; i < f.frames; ++i) {
-          im::gradient(frame(image, f, i), a, b, gx, gy);
-          std::copy(a.data(), a.data() + a.size(), mag.mutable_data() + i * a.size());
-          std::copy(b.data(), b.data() + b.size(), dir.mutable_data() + i * b.size());
-        }
-        py::gil_scoped_acquire acquire;
-        return py::make_tuple(mag, dir);
+        im::ImageD gx, gy;  // scratch
+        return two_maps(image, "gradient",
+                        [&](const ImageMap& img, im::ImageD& mag, im::ImageD& dir) {
+                          im::gradient(img, mag, dir, gx, gy);
+                        });
       },
       py::arg("image"),
       "(magnitude, direction): MATLAB's imgradient with Sobel kernels and replicated borders; "
@@ -294,18 +308,9 @@ counter-clockwise with y up.)doc");
   m.def(
       "sobel",
       [](const ArrayD& image) {
-        const Frames f = frames_of(image, "sobel");
-        auto ox = stack_like<double>(f);
-        auto oy = stack_like<double>(f);
-        py::gil_scoped_release release;
-        im::ImageD gx, gy;
-        for (py::ssize_t i = 0; i < f.frames; ++i) {
-          im::sobel(frame(image, f, i), gx, gy);
-          std::copy(gx.data(), gx.data() + gx.size(), ox.mutable_data() + i * gx.size());
-          std::copy(gy.data(), gy.data() + gy.size(), oy.mutable_data() + i * gy.size());
-        }
-        py::gil_scoped_acquire acquire;
-        return py::make_tuple(ox, oy);
+        return two_maps(image, "sobel", [](const ImageMap& img, im::ImageD& gx, im::ImageD& gy) {
+          im::sobel(img, gx, gy);
+        });
       },
       py::arg("image"),
       "(gx, gy): Sobel derivatives with replicated borders as MATLAB's imgradientxy; gx grows "

@@ -65,6 +65,17 @@ constexpr const char* name_of() {
   return "Mlp";
 }
 
+/// The options cross_validate and five_by_two_cv share.
+template <class Options>
+void evaluation_options(Options& opt, std::uint64_t seed, bool grouped, double snr_db,
+                        const std::string& noise_target, unsigned threads) {
+  opt.seed = seed;
+  opt.grouped = grouped;
+  opt.snr_db = snr_db;
+  opt.noise_target = enum_from(noise_target, kNoiseTargets, "noise_target");
+  opt.threads = threads;
+}
+
 /// fit / predict / decision_function / classes_ for a Classifier.
 template <class C>
 py::class_<C> bind_classifier(py::module_& m, const char* name, const char* doc) {
@@ -271,11 +282,7 @@ files.)doc");
         const DataArrays d = data_arrays(std::move(x), std::move(y), std::move(groups));
         ln::CvOptions opt;
         opt.folds = folds;
-        opt.seed = seed;
-        opt.grouped = grouped;
-        opt.snr_db = snr_db;
-        opt.noise_target = enum_from(noise_target, kNoiseTargets, "noise_target");
-        opt.threads = threads;
+        evaluation_options(opt, seed, grouped, snr_db, noise_target, threads);
         ln::CvReport r = with_classifier(model, [&](const auto& c) {
           py::gil_scoped_release release;
           return ln::cross_validate(c, d.view(), opt);
@@ -335,11 +342,7 @@ files.)doc");
         const DataArrays d = data_arrays(std::move(x), std::move(y), std::move(groups));
         ln::FiveByTwoOptions opt;
         opt.alpha = alpha;
-        opt.seed = seed;
-        opt.grouped = grouped;
-        opt.snr_db = snr_db;
-        opt.noise_target = enum_from(noise_target, kNoiseTargets, "noise_target");
-        opt.threads = threads;
+        evaluation_options(opt, seed, grouped, snr_db, noise_target, threads);
         ln::FiveByTwoResult r = with_classifier(a, [&](const auto& ca) {
           return with_classifier(b, [&](const auto& cb) {
             py::gil_scoped_release release;
