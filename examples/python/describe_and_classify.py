@@ -61,8 +61,8 @@ def main():
     axes[0].set_title("pressure")
     axes[1].imshow(seg.classes, cmap="gray")
     axes[1].set_title("k-means classes (K = 3)")
-    axes[2].imshow(image.rec_edged(seg), cmap="magma")
-    axes[2].set_title("RecEdged height")
+    axes[2].imshow(image.rec_edgeless(images[0], seg), cmap="magma")
+    axes[2].set_title("RecEdgeless height")
     for ax in axes:
         ax.set_axis_off()
     out = args.out / "palm_image.png"
