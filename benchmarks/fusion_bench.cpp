@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Contact fusion end to end (nearest within radius + policy update + index move, or insert)
 // for every policy x index, on 200k-contact sliding explorations of a sphere, a cylinder and a
-// box; plus query-only replay, a 100k-point growth case, and readings to contacts per active
-// tactel. Peers in the same binary:
-// nanoflann's dynamic adaptor (DynamicKdTree) and brute force.
+// box; frames of the pad model inserted one contact at a time and a frame at a time; plus
+// query-only replay, a 100k-point growth case, and readings to contacts per active tactel.
+// Peers in the same binary: DynamicKdTree (taxel's exact wrapper of nanoflann 1.4's
+// KDTreeSingleIndexDynamicAdaptor, a logarithmic forest of static kd-trees, as Debian 12 ships
+// it; not a newer nanoflann), brute force, and a reference hash grid on tsl::robin_map
+// (reference_grid.hpp, when robin-map-dev is installed).
 //   ./fusion_bench --benchmark_filter='Fuse<tf::Kalman<double>, ti::VoxelHash'
 //       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
@@ -11,11 +14,16 @@
 #include <algorithm>
 #include <map>
 #include <random>
+#include <span>
 #include <string>
 #include <taxel/fusion.hpp>
 #include <taxel/index.hpp>
 #include <taxel/sim.hpp>
 #include <vector>
+
+#ifdef TAXEL_BENCH_HAVE_ROBIN_MAP
+#include "reference_grid.hpp"
+#endif
 
 namespace tf = taxel::fusion;
 namespace ti = taxel::index;
@@ -132,6 +140,148 @@ BENCHMARK_TEMPLATE(Fuse, tf::Raw<double>, ti::DynamicKdTree<double>)->Apply(Shap
 BENCHMARK_TEMPLATE(Fuse, tf::Raw<double>, ti::BruteForce<double>)->Apply(Shapes);
 BENCHMARK_TEMPLATE(QueryReplay, ti::VoxelHash<double>)->Apply(Shapes);
 BENCHMARK_TEMPLATE(QueryReplay, ti::DynamicKdTree<double>)->Apply(Shapes);
+namespace {
+
+// Frames of the pad model: a 14x6 pad sliding, a 3-finger hand grasping and a fingertip
+// palpating (sim/exploration.hpp), one contact per active tactel, gate 4 mm as in the fusion
+// study. The contacts in stream order and where each frame (all pads of one time step) ends.
+struct Frames {
+  std::vector<taxel::Contact<double>> contacts;
+  std::vector<std::size_t> ends;
+};
+
+const Frames& pad_frames(ShapeId shape) {
+  static std::map<ShapeId, Frames> cache;
+  Frames& f = cache[shape];
+  if (!f.contacts.empty()) return f;
+  taxel::sim::ExplorationConfig cfg;
+  cfg.seed = 7;
+  const auto add = [&](const auto& ex) {
+    for (const auto& frame : ex.frames) {
+      if (frame.contacts.empty()) continue;
+      f.contacts.insert(f.contacts.end(), frame.contacts.begin(), frame.contacts.end());
+      f.ends.push_back(f.contacts.size());
+    }
+  };
+  const auto explore = [&](const auto& s) {
+    add(taxel::sim::explore_sliding(s, cfg, {.slides = 4, .frames = 1000}));
+    add(taxel::sim::explore_grasps(s, cfg, {.grasps = 8}));
+    add(taxel::sim::explore_palpation(s, cfg, {.touches = 40}));
+  };
+  switch (shape) {
+    case ShapeId::sphere:
+      explore(taxel::sim::Sphere(0.04));
+      break;
+    case ShapeId::cylinder:
+      explore(taxel::sim::Cylinder(0.03, 0.05));
+      break;
+    case ShapeId::box:
+      explore(taxel::sim::Box(taxel::Vec3d(0.04, 0.03, 0.02)));
+      break;
+  }
+  return f;
+}
+
+constexpr double kPadGate = 4e-3;
+
+void frame_counters(benchmark::State& state, const Frames& f, std::size_t points) {
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * f.contacts.size()));
+  state.counters["ns_per_contact"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * f.contacts.size()),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["points"] = static_cast<double>(points);
+  state.counters["per_frame"] = double(f.contacts.size()) / double(f.ends.size());
+}
+
+// ContactCloud, one contact at a time (the baseline for the frame insert).
+template <class Policy>
+void PadOneByOne(benchmark::State& state) {
+  const Frames& f = pad_frames(static_cast<ShapeId>(state.range(0)));
+  std::size_t points = 0;
+  for (auto _ : state) {
+    tf::ContactCloud<Policy, ti::VoxelHash<double>> cloud({.association_radius = kPadGate});
+    for (const auto& c : f.contacts) benchmark::DoNotOptimize(cloud.insert(c));
+    points = cloud.size();
+    benchmark::ClobberMemory();
+  }
+  frame_counters(state, f, points);
+}
+
+// ContactCloud, a frame at a time (insert_frame).
+template <class Policy>
+void PadFrames(benchmark::State& state) {
+  const Frames& f = pad_frames(static_cast<ShapeId>(state.range(0)));
+  std::size_t points = 0;
+  const std::span<const taxel::Contact<double>> all(f.contacts);
+  for (auto _ : state) {
+    tf::ContactCloud<Policy, ti::VoxelHash<double>> cloud({.association_radius = kPadGate});
+    std::size_t begin = 0;
+    for (const std::size_t end : f.ends) {
+      benchmark::DoNotOptimize(cloud.insert(all.subspan(begin, end - begin)));
+      begin = end;
+    }
+    points = cloud.size();
+    benchmark::ClobberMemory();
+  }
+  frame_counters(state, f, points);
+}
+
+#ifdef TAXEL_BENCH_HAVE_ROBIN_MAP
+// The reference hash grid (reference_grid.hpp), same policy, same stream.
+template <class Policy>
+void PadReferenceGrid(benchmark::State& state) {
+  const Frames& f = pad_frames(static_cast<ShapeId>(state.range(0)));
+  std::size_t points = 0;
+  for (auto _ : state) {
+    taxel_bench::ReferenceGrid<Policy> grid(kPadGate);
+    for (const auto& c : f.contacts) grid.insert(c);
+    points = grid.size();
+    benchmark::ClobberMemory();
+  }
+  // Same cloud as ContactCloud's, or the comparison means nothing.
+  tf::ContactCloud<Policy, ti::VoxelHash<double>> cloud({.association_radius = kPadGate});
+  for (const auto& c : f.contacts) (void)cloud.insert(c);
+  if (cloud.size() != points) state.SkipWithError("reference grid and ContactCloud differ");
+  frame_counters(state, f, points);
+}
+
+// The reference grid on the 200k-contact sliding streams (gate 2 mm), beside Fuse.
+template <class Policy>
+void FuseReferenceGrid(benchmark::State& state) {
+  const auto& contacts = stream<double>(static_cast<ShapeId>(state.range(0)));
+  std::size_t points = 0;
+  for (auto _ : state) {
+    taxel_bench::ReferenceGrid<Policy> grid(kRadius);
+    for (const auto& c : contacts) grid.insert(c);
+    points = grid.size();
+    benchmark::ClobberMemory();
+  }
+  state.counters["ns_per_contact"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * contacts.size()),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["points"] = static_cast<double>(points);
+}
+#endif
+
+void PadShapes(benchmark::internal::Benchmark* b) {
+  b->ArgName("shape")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+  b->ComputeStatistics("min", fastest);
+}
+
+}  // namespace
+
+BENCHMARK_TEMPLATE(PadOneByOne, tf::Kalman<double>)->Apply(PadShapes);
+BENCHMARK_TEMPLATE(PadFrames, tf::Kalman<double>)->Apply(PadShapes);
+#ifdef TAXEL_BENCH_HAVE_ROBIN_MAP
+BENCHMARK_TEMPLATE(PadReferenceGrid, tf::Kalman<double>)->Apply(PadShapes);
+BENCHMARK_TEMPLATE(FuseReferenceGrid, tf::Kalman<double>)->Apply(PadShapes);
+#endif
+BENCHMARK_TEMPLATE(PadOneByOne, tf::Surfel<double>)->Apply(PadShapes);
+BENCHMARK_TEMPLATE(PadFrames, tf::Surfel<double>)->Apply(PadShapes);
+#ifdef TAXEL_BENCH_HAVE_ROBIN_MAP
+BENCHMARK_TEMPLATE(PadReferenceGrid, tf::Surfel<double>)->Apply(PadShapes);
+#endif
+
 BENCHMARK_TEMPLATE(Growth, ti::VoxelHash<double>)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(Growth, ti::DynamicKdTree<double>)->Unit(benchmark::kMillisecond);
 

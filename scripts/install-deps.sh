@@ -11,12 +11,12 @@ python=(pybind11-dev python3-dev python3-numpy python3-venv python3-setuptools p
 python_test=(python3-pytest python3-scipy python3-skimage python3-matplotlib)
 case "$what" in
   build) ;;
-  test) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium "${python[@]}" "${python_test[@]}") ;;
-  bench) pkgs+=(libbenchmark-dev libpng-dev liblinear-dev) ;;
+  test) pkgs+=(catch2 libbenchmark-dev robin-map-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium "${python[@]}" "${python_test[@]}") ;;
+  bench) pkgs+=(libbenchmark-dev libpng-dev liblinear-dev robin-map-dev) ;;
   demo) pkgs+=(libpng-dev libusb-1.0-0-dev) ;;
   fuzz) pkgs+=(catch2 clang libclang-rt-14-dev) ;;
   python) pkgs+=("${python[@]}") ;;
-  all) pkgs+=(catch2 libbenchmark-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium clang libclang-rt-14-dev "${python[@]}" "${python_test[@]}") ;;
+  all) pkgs+=(catch2 libbenchmark-dev robin-map-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium clang libclang-rt-14-dev "${python[@]}" "${python_test[@]}") ;;
   *) echo "install-deps.sh: unknown set '$what' (build|test|bench|demo|fuzz|python|all)" >&2; exit 2 ;;
 esac
 

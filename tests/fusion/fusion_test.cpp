@@ -5,8 +5,10 @@
 #include <atomic>
 #include <catch2/catch.hpp>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <random>
+#include <span>
 #include <taxel/fusion.hpp>
 #include <taxel/index.hpp>
 #include <taxel/io/ply.hpp>
@@ -304,6 +306,73 @@ TEMPLATE_TEST_CASE("ContactCloud gives identical clouds over every index", "[fus
     REQUIRE(brute.observations(i) == voxel.observations(i));
     REQUIRE(brute.covariance(i) == kd.covariance(i));
   }
+}
+
+namespace {
+
+// Inserts `frames` (consecutive spans of `stream`) one contact at a time and a frame at a time
+// into clouds of policy P over index I, and requires the two clouds to be equal bit for bit.
+template <class P, class I>
+void require_frames_equal_one_by_one(const std::vector<taxel::Contact<double>>& stream,
+                                     const std::vector<std::size_t>& ends) {
+  tf::ContactCloud<P, I> one({.association_radius = 4e-3});
+  tf::ContactCloud<P, I> framed({.association_radius = 4e-3});
+  tf::BatchResult sum;
+  for (const auto& c : stream) (void)one.insert(c);
+  std::size_t begin = 0;
+  for (const std::size_t end : ends) {
+    const auto r = framed.insert(std::span(stream).subspan(begin, end - begin));
+    sum.added += r.added;
+    sum.fused += r.fused;
+    sum.rejected += r.rejected;
+    begin = end;
+  }
+  REQUIRE(framed.size() == one.size());
+  CHECK(sum.added == one.size());
+  CHECK(sum.added + sum.fused + sum.rejected == stream.size());
+  for (ti::PointId i = 0; i < one.size(); ++i) {
+    REQUIRE(framed.mean(i) == one.mean(i));
+    REQUIRE(framed.covariance(i) == one.covariance(i));
+    REQUIRE(framed.observations(i) == one.observations(i));
+    REQUIRE(framed.last_time(i) == one.last_time(i));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("a frame at a time equals one contact at a time over every policy and index",
+          "[fusion]") {
+  // Frames of the pad model (a sliding pad and a grasping hand, one contact per active tactel),
+  // with a few defective contacts mixed in so that rejections inside a frame are covered.
+  taxel::sim::ExplorationConfig cfg;
+  cfg.seed = 9;
+  std::vector<taxel::Contact<double>> stream;
+  std::vector<std::size_t> ends;
+  const auto add = [&](const auto& ex) {
+    for (const auto& f : ex.frames) {
+      if (f.contacts.empty()) continue;
+      stream.insert(stream.end(), f.contacts.begin(), f.contacts.end());
+      ends.push_back(stream.size());
+    }
+  };
+  const taxel::sim::Sphere sphere(0.04);
+  add(taxel::sim::explore_sliding(sphere, cfg, {.slides = 1, .frames = 150}));
+  add(taxel::sim::explore_grasps(sphere, cfg, {.grasps = 1}));
+  REQUIRE(ends.size() > 100);
+  for (std::size_t i = 7; i < stream.size(); i += 997) {
+    stream[i].position.x() = std::numeric_limits<double>::quiet_NaN();
+  }
+  using V = ti::VoxelHash<double>;
+  using K = ti::DynamicKdTree<double>;
+  using B = ti::BruteForce<double>;
+  require_frames_equal_one_by_one<tf::Kalman<double>, V>(stream, ends);
+  require_frames_equal_one_by_one<tf::Kalman<double>, K>(stream, ends);
+  require_frames_equal_one_by_one<tf::Kalman<double>, B>(stream, ends);
+  require_frames_equal_one_by_one<tf::Surfel<double>, V>(stream, ends);
+  require_frames_equal_one_by_one<tf::Surfel<double>, K>(stream, ends);
+  require_frames_equal_one_by_one<tf::Average<double>, V>(stream, ends);
+  require_frames_equal_one_by_one<tf::Average<double>, B>(stream, ends);
+  require_frames_equal_one_by_one<tf::Raw<double>, V>(stream, ends);
 }
 
 TEST_CASE("ContactCloud rejects invalid contacts and stays unchanged", "[fusion]") {
