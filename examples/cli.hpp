@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Shared command-line plumbing of the example tools: one-line errors with the tool's name and
-// an exit code, option values, strictly parsed numbers, JSON string escaping.
+// an exit code, option values, strictly parsed numbers and lengths with units, standard streams
+// for "-" (report.hpp: the results as text, JSON or CSV).
 #pragma once
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -13,7 +15,10 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <taxel/io/file.hpp>
 #include <taxel/version.hpp>
+#include <type_traits>
+#include <vector>
 
 namespace taxel_cli {
 
@@ -116,10 +121,52 @@ class Args {
     T v{};
     const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
     if (res.ec != std::errc() || res.ptr != text.data() + text.size() || !(v >= lo && v <= hi)) {
-      fail(std::string(current_) + ": '" + std::string(text) + "' is not a number in [" +
-           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      fail(std::string(current_) + ": '" + std::string(text) + "' is not " + range(lo, hi));
     }
     return v;
+  }
+
+  /// The current option's value as a length in metres within [lo, hi] metres: a number in
+  /// metres ("0.004"), or a number with a unit: m, cm, mm, um or µm ("4mm", "0.4 cm").
+  double length(double lo, double hi) {
+    const std::string_view text = value();
+    double v = 0;
+    const char* end = text.data() + text.size();
+    const auto res = std::from_chars(text.data(), end, v);
+    bool ok = res.ec == std::errc() && std::isfinite(v);
+    if (ok) {
+      std::string_view unit(res.ptr, static_cast<std::size_t>(end - res.ptr));
+      while (!unit.empty() && unit.front() == ' ') unit.remove_prefix(1);
+      if (unit.empty() || unit == "m") {
+      } else if (unit == "cm") {
+        v *= 1e-2;
+      } else if (unit == "mm") {
+        v *= 1e-3;
+      } else if (unit == "um" || unit == "\u00b5m" || unit == "\u03bcm") {
+        v *= 1e-6;
+      } else {
+        ok = false;
+      }
+    }
+    if (!ok || !(v >= lo && v <= hi)) {
+      fail(std::string(current_) + ": '" + std::string(text) +
+           "' is not a length (metres, or a number with a unit m, cm, mm or um: 4mm, 0.004)" +
+           (std::isinf(lo) && std::isinf(hi) ? std::string() : " in " + bounds(lo, hi) + " m"));
+    }
+    return v;
+  }
+
+  /// The current option's value as an output format among `allowed` (e.g. "text|json|csv").
+  std::string_view choice(std::string_view allowed) {
+    const std::string_view v = value();
+    for (std::size_t pos = 0; pos <= allowed.size();) {
+      const std::size_t bar = std::min(allowed.find('|', pos), allowed.size());
+      if (allowed.substr(pos, bar - pos) == v) return v;
+      pos = bar + 1;
+    }
+    std::string list(allowed);
+    for (char& c : list) c = c == '|' ? ',' : c;
+    fail(std::string(current_) + " must be one of " + list + ", not '" + std::string(v) + "'");
   }
 
   /// Prints "<tool>: <why>" and exits with `code`.
@@ -129,6 +176,30 @@ class Args {
   }
 
  private:
+  template <class T>
+  static std::string range(T lo, T hi) {
+    if constexpr (std::is_floating_point_v<T>) {
+      if (std::isinf(lo) && std::isinf(hi)) return "a finite number";
+    }
+    return "a number in " + bounds(lo, hi);
+  }
+  template <class T>
+  static std::string bounds(T lo, T hi) {
+    const auto one = [](T v) {
+      if constexpr (std::is_floating_point_v<T>) {
+        if (std::isinf(v)) return std::string(v < 0 ? "-inf" : "inf");
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
+        return std::string(buf);
+      } else {
+        return std::to_string(v);
+      }
+    };
+    std::string out = "[";
+    out.append(one(lo)).append(", ").append(one(hi)).append("]");
+    return out;
+  }
+
   const char* tool_;
   int argc_;
   char** argv_;
@@ -167,6 +238,24 @@ inline StudyOptions parse_study_options(const char* tool, const char* usage,
                                         std::string default_out, int argc, char** argv) {
   return parse_study_options(tool, usage, std::move(default_out), argc, argv,
                              [](std::string_view, Args&) { return false; });
+}
+
+/// The bytes of the input `path`: standard input when `path` is "-". Throws taxel::IoError.
+inline std::string read_input(const std::string& path) {
+  return taxel::io::read_file(path == "-" ? "/dev/stdin" : path);
+}
+
+/// The name of an input in messages: "<stdin>" for "-".
+inline std::string input_name(const std::string& path) { return path == "-" ? "<stdin>" : path; }
+
+/// Writes `bytes` to the output `path`, whole or not at all (taxel::io::write_file), or to
+/// standard output when `path` is "-" (a lost write there is caught at exit).
+inline void write_output(const std::string& path, std::string_view bytes) {
+  if (path == "-") {
+    std::fwrite(bytes.data(), 1, bytes.size(), stdout);
+  } else {
+    taxel::io::write_file(path, bytes);
+  }
 }
 
 /// `s` with quotes and backslashes escaped and control characters blanked, for JSON strings.

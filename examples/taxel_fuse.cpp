@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -75,12 +76,18 @@ readings (--readings, --session):
   --sigma-position S  pad position noise from the kinematics [m] (default 0.0002)
   --sigma-tilt S    pad rotation noise from the kinematics [rad] (default 0.02)
   --frame-rate F    frames per second, for poses without a time (default 1000)
+
+  --format text|json|csv   how the summary is printed (default text)
   -h, --help        show this help
   --version         show taxel's version
 
-Prints the counts (contacts, added, fused, rejected by reason, rows of CONTACTS.csv skipped,
-points, points written) and the time per contact.
-Exit status: 0 on success, 1 for unreadable input, 2 for bad options.
+Lengths take a unit: 3.4mm, 0.34cm, 3400um or 0.0034 (metres). CONTACTS.csv may be - for
+standard input and CLOUD.ply - for standard output; the summary then goes to standard error.
+
+Prints a summary: the counts (contacts, added, fused, rejected and rejected_by reason, rows of
+CONTACTS.csv skipped, points, points written), the time per contact and, for readings and
+sessions, what was read.
+Exit status: 0 on success, 1 for unreadable input or a lost write, 2 for bad options.
 )usage";
 
 struct Options {
@@ -98,11 +105,27 @@ struct Options {
   taxel::sensor::SensorModel model;
   double max_sigma = std::numeric_limits<double>::infinity();
   double scale = 1.0;
+  taxel_cli::Format format = taxel_cli::Format::text;
   std::vector<std::string> files;
 };
 
 // Rows of CONTACTS.csv skipped as bad (not --strict), for the summary.
 std::size_t skipped_rows = 0;
+
+// The summary, printed at the end (to standard error when the cloud goes to standard output).
+taxel_cli::Json summary = taxel_cli::Json::object();
+
+// "covariance is not finite" -> "covariance_is_not_finite": a field name in every format.
+std::string field_name(std::string_view why) {
+  std::string s(why);
+  for (char& c : s) c = c == ' ' ? '_' : c;
+  return s;
+}
+
+void print_summary(const Options& o) {
+  const std::string text = taxel_cli::render(summary, o.format);
+  std::fwrite(text.data(), 1, text.size(), o.files[1] == "-" ? stderr : stdout);
+}
 
 template <class Cloud>
 int fuse(const Options& o, typename Cloud::Config cfg,
@@ -127,14 +150,21 @@ int fuse(const Options& o, typename Cloud::Config cfg,
     }
   }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("contacts %zu\nadded %zu\nfused %zu\n", contacts.size(), added, fused);
+  summary["contacts"] = contacts.size();
+  summary["added"] = added;
+  summary["fused"] = fused;
   std::size_t total_rejected = 0;
-  for (const auto& [why, n] : rejected) total_rejected += n;
-  std::printf("rejected %zu", total_rejected);
-  for (const auto& [why, n] : rejected) std::printf(" (%s %zu)", why.c_str(), n);
-  std::printf("\nskipped_rows %zu", skipped_rows);
-  std::printf("\npoints %zu\ntime %.0f ns per contact\n", cloud.size(),
-              contacts.empty() ? 0.0 : 1e9 * s / static_cast<double>(contacts.size()));
+  auto by = taxel_cli::Json::object();
+  for (const auto& [why, n] : rejected) {
+    total_rejected += n;
+    by[field_name(why)] = n;
+  }
+  summary["rejected"] = total_rejected;
+  if (!by.empty()) summary["rejected_by"] = by;
+  summary["skipped_rows"] = skipped_rows;
+  summary["points"] = cloud.size();
+  summary["ns_per_contact"] =
+      std::llround(contacts.empty() ? 0.0 : 1e9 * s / static_cast<double>(contacts.size()));
   if (o.policy != "raw" && fused == 0 && added >= 100) {  // raw never fuses
     std::fprintf(stderr,
                  "taxel-fuse: warning: no contact fused with another: the association radius "
@@ -143,14 +173,16 @@ int fuse(const Options& o, typename Cloud::Config cfg,
                  o.radius);
   }
   const auto kept = cloud.to_point_cloud({o.min_observations, o.max_sigma});
-  std::printf("written %zu\n", kept.size());
+  summary["written"] = kept.size();
   try {
-    taxel::io::write_ply(
-        o.files[1], kept,
-        o.ascii ? taxel::io::PlyFormat::ascii : taxel::io::PlyFormat::binary_little_endian);
+    taxel_cli::write_output(
+        o.files[1],
+        taxel::io::encode_ply(kept, o.ascii ? taxel::io::PlyFormat::ascii
+                                            : taxel::io::PlyFormat::binary_little_endian));
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }
+  print_summary(o);
   return 0;
 }
 
@@ -183,8 +215,8 @@ std::string session_contacts(const Options& o, const taxel::sensor::ContactOptio
   namespace td = taxel::drivers;
   std::map<std::uint32_t, std::vector<Eigen::Isometry3d>> by_time;
   if (!o.poses.empty()) {
-    const std::string text = taxel::io::read_file(o.poses);
-    for (const auto& p : taxel::io::parse_pad_poses_csv(text, o.poses)) {
+    const std::string text = taxel_cli::read_input(o.poses);
+    for (const auto& p : taxel::io::parse_pad_poses_csv(text, taxel_cli::input_name(o.poses))) {
       auto& v = by_time[static_cast<std::uint32_t>(std::lround(p.time * 1e3))];
       if (v.size() <= p.pad) v.resize(p.pad + 1, Eigen::Isometry3d::Identity());
       v[p.pad] = p.pose;
@@ -220,8 +252,8 @@ std::string session_contacts(const Options& o, const taxel::sensor::ContactOptio
   const std::string shortfall =
       td::replay_shortfall(dev.transport(), dev.unparsed_bytes(), file.error);
   dev.close();
-  std::printf("session %zu frames (with poses %zu) of %zu matrices\n", frames, posed,
-              dev.matrices().size());
+  summary["session"] = {{"frames", frames}, {"frames_with_poses", posed},
+                        {"matrices", dev.matrices().size()}};
   return shortfall;
 }
 
@@ -250,15 +282,15 @@ int main(int argc, char** argv) {
         args.fail("--index must be voxel-hash, kd-tree or brute-force");
       }
     } else if (a == "--radius") {
-      o.radius = args.number<double>(-kInf, kInf);
+      o.radius = args.length(-kInf, kInf);
     } else if (a == "--gate") {
       o.gate = args.number<double>(-kInf, kInf);
     } else if (a == "--process-noise") {
-      o.process_noise = args.number<double>(-kInf, kInf);
+      o.process_noise = args.length(-kInf, kInf);
     } else if (a == "--min-observations") {
       o.min_observations = args.number<std::uint32_t>(1, 4294967295u);
     } else if (a == "--max-sigma") {
-      o.max_sigma = args.number<double>(0.0, kInf);
+      o.max_sigma = args.length(0.0, kInf);
     } else if (a == "--strict") {
       o.strict = true;
     } else if (a == "--ascii") {
@@ -274,21 +306,23 @@ int main(int argc, char** argv) {
     } else if (a == "--per-pad") {
       o.per_pad = true;
     } else if (a == "--pitch") {
-      o.model.geometry.pitch = args.number<double>(0.0, kInf);
+      o.model.geometry.pitch = args.length(0.0, kInf);
     } else if (a == "--levels") {
       o.model.levels = args.number<int>(2, 65536);
     } else if (a == "--full-scale-depth") {
-      o.model.full_scale_depth = args.number<double>(0.0, kInf);
+      o.model.full_scale_depth = args.length(0.0, kInf);
     } else if (a == "--threshold") {
       o.model.threshold = args.number<int>(1, 65535);
     } else if (a == "--sigma-normal") {
-      o.model.sigma_normal = args.number<double>(0.0, kInf);
+      o.model.sigma_normal = args.length(0.0, kInf);
     } else if (a == "--sigma-position") {
-      o.model.sigma_position = args.number<double>(0.0, kInf);
+      o.model.sigma_position = args.length(0.0, kInf);
     } else if (a == "--sigma-tilt") {
       o.model.sigma_tilt = args.number<double>(0.0, kInf);
     } else if (a == "--frame-rate") {
       o.frame_rate = args.number<double>(0.0, kInf);
+    } else if (a == "--format") {
+      o.format = taxel_cli::to_format(args.choice("text|json|csv"));
     } else if (a.size() > 1 && a[0] == '-') {
       args.fail("unknown option '" + std::string(a) + "' (see --help)");
     } else {
@@ -312,6 +346,9 @@ int main(int argc, char** argv) {
                         : "expected CONTACTS.csv and CLOUD.ply (see --help)");
   }
   if (want == 1) o.files.insert(o.files.begin(), std::string());
+  if ((o.files[0] == "-") + (o.readings == "-") + (o.poses == "-") > 1) {
+    args.fail("only one input can be standard input (-)");
+  }
   std::vector<taxel::Contact<double>> contacts;
   taxel::sensor::ContactOptions copt;
   copt.mode =
@@ -319,15 +356,18 @@ int main(int argc, char** argv) {
   std::string shortfall;  // a session replay that ended early: the output is kept, exit 1
   try {
     if (from_readings) {
-      auto stack = taxel::sensor::ReadingStack::from_npy(taxel::io::read_npy_u16(o.readings));
-      const auto poses = taxel::io::read_pad_poses_csv(o.poses);
+      auto stack = taxel::sensor::ReadingStack::from_npy(taxel::io::parse_npy_u16(
+          taxel_cli::read_input(o.readings), taxel_cli::input_name(o.readings)));
+      const auto poses = taxel::io::parse_pad_poses_csv(taxel_cli::read_input(o.poses),
+                                                        taxel_cli::input_name(o.poses));
       taxel::sensor::SensorModel model = o.model;
       model.geometry.rows = static_cast<int>(stack.rows);
       model.geometry.cols = static_cast<int>(stack.cols);
       const auto r =
           taxel::sensor::contacts_from_readings(stack, poses, model, copt, o.frame_rate, contacts);
-      std::printf("readings %zu frames x %zu pads of %zu x %zu\npad frames %zu (touching %zu)\n",
-                  stack.frames, stack.pads, stack.rows, stack.cols, r.pad_frames, r.touching);
+      summary["readings"] = {{"frames", stack.frames},        {"pads", stack.pads},
+                             {"rows", stack.rows},            {"cols", stack.cols},
+                             {"pad_frames", r.pad_frames}, {"touching", r.touching}};
     } else if (from_session) {
       shortfall = session_contacts(o, copt, contacts);
       if (!shortfall.empty()) {
@@ -336,9 +376,11 @@ int main(int argc, char** argv) {
       }
     } else {
       taxel::io::ContactsCsvReport report;
-      contacts = taxel::io::read_contacts_csv(o.files[0], {.strict = o.strict}, &report);
+      const std::string name = taxel_cli::input_name(o.files[0]);
+      contacts = taxel::io::parse_contacts_csv(taxel_cli::read_input(o.files[0]), name,
+                                               {.strict = o.strict}, &report);
       for (const auto& c : report.ignored_columns) {
-        std::fprintf(stderr, "taxel-fuse: %s: ignoring unknown column '%s'\n", o.files[0].c_str(),
+        std::fprintf(stderr, "taxel-fuse: %s: ignoring unknown column '%s'\n", name.c_str(),
                      c.c_str());
       }
       skipped_rows = report.skipped_rows;
@@ -356,7 +398,7 @@ int main(int argc, char** argv) {
       std::vector<Eigen::Vector3d> at;
       at.reserve(contacts.size());
       for (const auto& c : contacts) at.push_back(c.position);
-      taxel_cli::warn_if_millimetres("taxel-fuse", o.files[0], taxel_cli::largest_extent(at));
+      taxel_cli::warn_if_millimetres("taxel-fuse", name, taxel_cli::largest_extent(at));
     }
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);

@@ -5,7 +5,7 @@
 set -euo pipefail
 
 what=${1:-test}
-pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev)
+pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev nlohmann-json3-dev)
 # The Python module, and what its tests and examples compare with or plot through.
 python=(pybind11-dev python3-dev python3-numpy python3-venv python3-setuptools python3-pip)
 python_test=(python3-pytest python3-scipy python3-skimage python3-matplotlib)

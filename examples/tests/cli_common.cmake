@@ -27,3 +27,31 @@ function(expect_one_line text)
     message(FATAL_ERROR "expected a one-line error, got:\n${text}")
   endif()
 endfunction()
+
+# Like run_tool, with the file `input` (in WORK_DIR) as standard input.
+function(run_tool_stdin tool expect_rc input)
+  execute_process(COMMAND "${tool}" ${ARGN} WORKING_DIRECTORY "${WORK_DIR}"
+                  INPUT_FILE "${WORK_DIR}/${input}"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL expect_rc)
+    message(FATAL_ERROR "${tool} ${ARGN} < ${input}: exit ${rc}, expected ${expect_rc}\n${out}\n${err}")
+  endif()
+  set(out "${out}" PARENT_SCOPE)
+  set(err "${err}" PARENT_SCOPE)
+endfunction()
+
+# Parses `text` as JSON (CMake's own parser) and sets `var` to the member at the path ARGN
+# (names and array indexes); fails when the text is not JSON or the member is missing.
+function(json_get var text)
+  string(JSON value ERROR_VARIABLE json_error GET "${text}" ${ARGN})
+  if(json_error)
+    message(FATAL_ERROR "not valid JSON, or no member ${ARGN}: ${json_error}\n${text}")
+  endif()
+  set(${var} "${value}" PARENT_SCOPE)
+endfunction()
+
+# `--version` prints "<name> (taxel) <version>" and exits 0.
+function(expect_version tool name)
+  run_tool("${tool}" 0 --version)
+  expect("${out}" "^${name} \\(taxel\\) [0-9]+\\.[0-9]+\\.[0-9]+\n$")
+endfunction()
