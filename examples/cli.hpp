@@ -82,6 +82,28 @@ inline bool warn_if_millimetres(const char* tool, const std::string& what, doubl
   return true;
 }
 
+/// Parses a finite length into `metres`: a number in metres ("0.004") or a number with a unit,
+/// m, cm, mm, um or µm ("4mm", "0.4 cm"). False when `text` is neither.
+inline bool parse_length(std::string_view text, double& metres) {
+  double v = 0;
+  const char* end = text.data() + text.size();
+  const auto res = std::from_chars(text.data(), end, v);
+  if (res.ec != std::errc() || !std::isfinite(v)) return false;
+  std::string_view unit(res.ptr, static_cast<std::size_t>(end - res.ptr));
+  while (!unit.empty() && unit.front() == ' ') unit.remove_prefix(1);
+  if (unit == "cm") {
+    v *= 1e-2;
+  } else if (unit == "mm") {
+    v *= 1e-3;
+  } else if (unit == "um" || unit == "\u00b5m" || unit == "\u03bcm") {
+    v *= 1e-6;
+  } else if (!unit.empty() && unit != "m") {
+    return false;
+  }
+  metres = v;
+  return true;
+}
+
 /// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).
 class Args {
  public:
@@ -131,24 +153,7 @@ class Args {
   double length(double lo, double hi) {
     const std::string_view text = value();
     double v = 0;
-    const char* end = text.data() + text.size();
-    const auto res = std::from_chars(text.data(), end, v);
-    bool ok = res.ec == std::errc() && std::isfinite(v);
-    if (ok) {
-      std::string_view unit(res.ptr, static_cast<std::size_t>(end - res.ptr));
-      while (!unit.empty() && unit.front() == ' ') unit.remove_prefix(1);
-      if (unit.empty() || unit == "m") {
-      } else if (unit == "cm") {
-        v *= 1e-2;
-      } else if (unit == "mm") {
-        v *= 1e-3;
-      } else if (unit == "um" || unit == "\u00b5m" || unit == "\u03bcm") {
-        v *= 1e-6;
-      } else {
-        ok = false;
-      }
-    }
-    if (!ok || !(v >= lo && v <= hi)) {
+    if (!parse_length(text, v) || !(v >= lo && v <= hi)) {
       fail(std::string(current_) + ": '" + std::string(text) +
            "' is not a length (metres, or a number with a unit m, cm, mm or um: 4mm, 0.004)" +
            (std::isinf(lo) && std::isinf(hi) ? std::string() : " in " + bounds(lo, hi) + " m"));

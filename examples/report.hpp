@@ -96,7 +96,10 @@ inline std::string render(const Json& report, Format format) {
     } else {
       if (r > 0) out += "\n";
       for (std::size_t i = 0; i < keys[r].size(); ++i) {
-        out.append(keys[r][i]).append(" ").append(detail::scalar(*values[r][i], false)).append("\n");
+        out.append(keys[r][i])
+            .append(" ")
+            .append(detail::scalar(*values[r][i], false))
+            .append("\n");
       }
     }
   }

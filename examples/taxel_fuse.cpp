@@ -252,8 +252,8 @@ std::string session_contacts(const Options& o, const taxel::sensor::ContactOptio
   const std::string shortfall =
       td::replay_shortfall(dev.transport(), dev.unparsed_bytes(), file.error);
   dev.close();
-  summary["session"] = {{"frames", frames}, {"frames_with_poses", posed},
-                        {"matrices", dev.matrices().size()}};
+  summary["session"] = {
+      {"frames", frames}, {"frames_with_poses", posed}, {"matrices", dev.matrices().size()}};
   return shortfall;
 }
 
@@ -365,8 +365,8 @@ int main(int argc, char** argv) {
       model.geometry.cols = static_cast<int>(stack.cols);
       const auto r =
           taxel::sensor::contacts_from_readings(stack, poses, model, copt, o.frame_rate, contacts);
-      summary["readings"] = {{"frames", stack.frames},        {"pads", stack.pads},
-                             {"rows", stack.rows},            {"cols", stack.cols},
+      summary["readings"] = {{"frames", stack.frames},     {"pads", stack.pads},
+                             {"rows", stack.rows},         {"cols", stack.cols},
                              {"pad_frames", r.pad_frames}, {"touching", r.touching}};
     } else if (from_session) {
       shortfall = session_contacts(o, copt, contacts);

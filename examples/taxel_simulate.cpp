@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -67,8 +68,13 @@ options:
   --truth-points N   samples of the true surface in TRUTH.ply (default 10000)
   --readings F.npy   also write the readings of the frames that gave the contacts
   --poses F.csv      also write the pads' believed poses (frame,pad,x,y,z,qw,qx,qy,qz,time)
+  --format text|json|csv   how the summary is printed (default text)
   -h, --help         show this help
   --version          show taxel's version
+
+Lengths take a unit: 3.4mm, 0.34cm, 3400um or 0.0034 (metres); --size and the position of
+--pose too (--size 40mm). Any one output may be - for standard output (the summary then goes to
+standard error), and --mesh - reads the mesh from standard input.
 
 Exit status: 0 on success, 1 for unreadable or unwritable files, 2 for bad options.
 )usage";
@@ -87,10 +93,14 @@ struct Options {
   std::size_t truth_points = 10000;
   std::string readings, poses;
   std::vector<std::string> files;
+  taxel_cli::Format format = taxel_cli::Format::text;
+  bool to_stdout = false;  // an output is "-": the summary goes to standard error
 };
 
+// Comma-separated numbers; lengths (`lengths`: every value, else the first `lengths_first`)
+// may carry a unit (4mm).
 std::vector<double> numbers(const taxel_cli::Args& args, std::string_view option,
-                            std::string_view text) {
+                            std::string_view text, std::size_t lengths_first = 0) {
   std::vector<double> out;
   std::size_t p = 0;
   while (p <= text.size()) {
@@ -98,10 +108,15 @@ std::vector<double> numbers(const taxel_cli::Args& args, std::string_view option
     const std::string_view tok = text.substr(p, e - p);
     double v = 0.0;
     const auto res = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-    if (tok.empty() || res.ec != std::errc() || res.ptr != tok.data() + tok.size() ||
-        !std::isfinite(v)) {
+    const bool ok = out.size() < lengths_first
+                        ? taxel_cli::parse_length(tok, v)
+                        : !tok.empty() && res.ec == std::errc() &&
+                              res.ptr == tok.data() + tok.size() && std::isfinite(v);
+    if (!ok) {
       std::string why(option);
-      why.append(": '").append(tok).append("' is not a finite number");
+      why.append(": '").append(tok).append(out.size() < lengths_first
+                                               ? "' is not a finite length (4mm, 0.004)"
+                                               : "' is not a finite number");
       args.fail(why);
     }
     out.push_back(v);
@@ -158,9 +173,10 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
     ++frames;
   }
   try {
-    taxel::io::write_contacts_csv(o.files[0], contacts);
+    taxel_cli::write_output(o.files[0], taxel::io::encode_contacts_csv(contacts));
     if (o.files.size() > 1) {
-      taxel::io::write_ply(o.files[1], ts::sample_surface(ex.truth, o.truth_points, o.config.seed));
+      taxel_cli::write_output(o.files[1], taxel::io::encode_ply(ts::sample_surface(
+                                              ex.truth, o.truth_points, o.config.seed)));
     }
     if (!o.readings.empty() || !o.poses.empty()) {
       const auto& g = o.config.sensor.geometry;
@@ -176,15 +192,21 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
       }
       const std::size_t dims[4] = {frames, pads, std::size_t(g.rows), std::size_t(g.cols)};
       if (!o.readings.empty()) {
-        taxel::io::write_file(o.readings, taxel::io::encode_npy_u16(dims, values));
+        taxel_cli::write_output(o.readings, taxel::io::encode_npy_u16(dims, values));
       }
-      if (!o.poses.empty()) taxel::io::write_file(o.poses, taxel::io::encode_pad_poses_csv(poses));
+      if (!o.poses.empty()) {
+        taxel_cli::write_output(o.poses, taxel::io::encode_pad_poses_csv(poses));
+      }
     }
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }
-  std::printf("shape %s\nexploration %s\ncontacts %zu\nframes %zu\n", o.shape.c_str(),
-              o.exploration.c_str(), contacts.size(), frames);
+  const taxel_cli::Json summary = {{"shape", o.shape},
+                                   {"exploration", o.exploration},
+                                   {"contacts", contacts.size()},
+                                   {"frames", frames}};
+  const std::string text = taxel_cli::render(summary, o.format);
+  std::fwrite(text.data(), 1, text.size(), o.to_stdout ? stderr : stdout);
   return 0;
 }
 
@@ -209,13 +231,13 @@ int main(int argc, char** argv) {
         args.fail("--shape must be sphere, cylinder, box, cone, ellipsoid, torus or mesh");
       }
     } else if (a == "--size") {
-      o.size = numbers(args, "--size", args.value());
+      o.size = numbers(args, "--size", args.value(), std::size_t(-1));
     } else if (a == "--scale") {
       o.scale = args.number<double>(1e-300, 1e300);
     } else if (a == "--mesh") {
       o.mesh = std::string(args.value());
     } else if (a == "--pose") {
-      const std::vector<double> v = numbers(args, "--pose", args.value());
+      const std::vector<double> v = numbers(args, "--pose", args.value(), 3);
       if (v.size() != 3 && v.size() != 6) args.fail("--pose takes 3 or 6 numbers");
       o.config.object_pose.translation() = taxel::Vec3d(v[0], v[1], v[2]);
       if (v.size() == 6) {
@@ -260,13 +282,13 @@ int main(int argc, char** argv) {
       sensor.geometry.rows = r;
       sensor.geometry.cols = c;
     } else if (a == "--pitch") {
-      sensor.geometry.pitch = args.number<double>(-kInf, kInf);
+      sensor.geometry.pitch = args.length(-kInf, kInf);
     } else if (a == "--indentation") {
-      o.config.indentation = args.number<double>(-kInf, kInf);
+      o.config.indentation = args.length(-kInf, kInf);
     } else if (a == "--sigma-normal") {
-      sensor.sigma_normal = args.number<double>(-kInf, kInf);
+      sensor.sigma_normal = args.length(-kInf, kInf);
     } else if (a == "--sigma-position") {
-      sensor.sigma_position = args.number<double>(-kInf, kInf);
+      sensor.sigma_position = args.length(-kInf, kInf);
     } else if (a == "--tilt") {
       sensor.sigma_tilt = args.number<double>(-kInf, kInf);
     } else if (a == "--frame-rate") {
@@ -279,6 +301,8 @@ int main(int argc, char** argv) {
       o.poses = std::string(args.value());
     } else if (a == "--truth-points") {
       o.truth_points = args.number<std::size_t>(1, std::size_t{1} << 26);
+    } else if (a == "--format") {
+      o.format = taxel_cli::to_format(args.choice("text|json|csv"));
     } else if (a.size() > 1 && a[0] == '-') {
       args.fail("unknown option '" + std::string(a) + "' (see --help)");
     } else {
@@ -287,6 +311,13 @@ int main(int argc, char** argv) {
   }
   if (o.files.empty() || o.files.size() > 2)
     args.fail("expected CONTACTS.csv [TRUTH.ply] (see --help)");
+  {
+    int dash = 0;
+    for (const std::string* f : {&o.readings, &o.poses}) dash += *f == "-";
+    for (const std::string& f : o.files) dash += f == "-";
+    if (dash > 1) args.fail("only one output can be standard output (-)");
+    o.to_stdout = dash == 1;
+  }
   if (o.shape == "mesh" && o.mesh.empty()) args.fail("--shape mesh needs --mesh FILE.ply");
   if (o.shape != "mesh" && !o.mesh.empty()) args.fail("--mesh is only used with --shape mesh");
   if (o.shape != "mesh" && o.scale != 1.0) args.fail("--scale is only used with --shape mesh");
@@ -323,20 +354,20 @@ int main(int argc, char** argv) {
     }
     taxel::io::PlyData ply;
     try {
-      ply = taxel::io::read_ply(o.mesh);
+      ply = taxel::io::parse_ply(taxel_cli::read_input(o.mesh), taxel_cli::input_name(o.mesh));
     } catch (const std::exception& e) {
       args.fail(e.what(), 1);
     }
     if (o.scale != 1.0) {
       for (auto& p : ply.cloud.points) p *= o.scale;
     }
-    taxel_cli::warn_if_millimetres("taxel-simulate", o.mesh,
+    taxel_cli::warn_if_millimetres("taxel-simulate", taxel_cli::input_name(o.mesh),
                                    taxel_cli::largest_extent(ply.cloud.points));
     std::optional<ts::TriangleMesh> mesh;
     try {
       mesh.emplace(std::move(ply.cloud.points), std::move(ply.triangles));
     } catch (const std::invalid_argument& e) {  // a mesh TriangleMesh refuses is bad data
-      args.fail(o.mesh + ": " + e.what(), 1);
+      args.fail(taxel_cli::input_name(o.mesh) + ": " + e.what(), 1);
     }
     return run(o, *mesh, args);
   } catch (const std::invalid_argument& e) {  // a shape or exploration parameter out of range
