@@ -4,6 +4,7 @@
 // formats agree.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -54,6 +55,22 @@ inline std::string scalar(const Json& v, bool csv) {
   return v.dump();
 }
 }  // namespace detail
+
+/// A rigid transform as report fields: "transform" (16 numbers, row-major), "translation"
+/// (x, y, z) and the rotation as "axis" (unit vector) and "angle" [rad].
+inline Json pose_fields(const Eigen::Isometry3d& T) {
+  Json j = Json::object();
+  Json m = Json::array();
+  for (int k = 0; k < 16; ++k) m.push_back(T.matrix()(k / 4, k % 4));
+  j["transform"] = std::move(m);
+  const Eigen::Vector3d t = T.translation();
+  j["translation"] = {t.x(), t.y(), t.z()};
+  const Eigen::AngleAxisd aa(T.rotation());
+  const Eigen::Vector3d axis = aa.angle() > 0 ? aa.axis() : Eigen::Vector3d::UnitZ();
+  j["axis"] = {axis.x(), axis.y(), axis.z()};
+  j["angle"] = aa.angle();
+  return j;
+}
 
 /// `report` as `format`:
 ///  - json: the document, indented (NaN and infinities become null, as JSON has neither);

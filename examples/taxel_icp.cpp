@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -43,8 +44,15 @@ options:
   --mesh-spacing D      sample a TARGET mesh at about one point per D^2 (default 0.001;
                         0: use its vertices only)
   -o FILE               also write the aligned source as PLY
+  --format text|json|csv  how the result is printed (default text; json and csv give the
+                        transform as 16 row-major numbers, its translation, rotation axis and
+                        angle, and the same figures)
   -h, --help            show this help
   --version             show taxel's version
+
+Lengths take a unit: 2mm, 0.2cm or 0.002 (metres). SOURCE or TARGET may be - for standard
+input, and -o - writes the aligned source to standard output (the result then goes to standard
+error).
 
 Exit status: 0 when ICP ran (whatever its status), 1 for unreadable input, 2 for bad options.
 )usage";
@@ -69,6 +77,7 @@ struct Options {
   double scale = 1.0;
   double mesh_spacing = 1e-3;
   std::string output;
+  taxel_cli::Format format = taxel_cli::Format::text;
   std::vector<std::string> inputs;
 };
 
@@ -93,9 +102,9 @@ Options parse(taxel_cli::Args& args) {
         args.fail("--kernel must be none, huber, cauchy, geman-mcclure or tukey");
       }
     } else if (a == "--kernel-scale") {
-      o.kernel_scale = args.number<double>(1e-300, kInf);
+      o.kernel_scale = args.length(1e-300, kInf);
     } else if (a == "--max-distance") {
-      o.icp.max_distance = args.number<double>(-kInf, kInf);
+      o.icp.max_distance = args.length(-kInf, kInf);
     } else if (a == "--trim") {
       o.icp.trim_fraction = args.number<double>(-kInf, kInf);
     } else if (a == "--max-iterations") {
@@ -122,9 +131,11 @@ Options parse(taxel_cli::Args& args) {
     } else if (a == "--scale") {
       o.scale = args.number<double>(1e-300, 1e300);
     } else if (a == "--mesh-spacing") {
-      o.mesh_spacing = args.number<double>(0.0, 1e300);
+      o.mesh_spacing = args.length(0.0, 1e300);
     } else if (a == "-o") {
       o.output = std::string(args.value());
+    } else if (a == "--format") {
+      o.format = taxel_cli::to_format(args.choice("text|json|csv"));
     } else if (a.size() > 1 && a[0] == '-') {
       args.fail("unknown option '" + std::string(a) + "' (see --help)");
     } else {
@@ -132,6 +143,9 @@ Options parse(taxel_cli::Args& args) {
     }
   }
   if (o.inputs.size() != 2) args.fail("expected SOURCE.ply and TARGET.ply (see --help)");
+  if (o.inputs[0] == "-" && o.inputs[1] == "-") {
+    args.fail("only one input can be standard input (-)");
+  }
   return o;
 }
 
@@ -161,9 +175,11 @@ int main(int argc, char** argv) {
   taxel_cli::Args args("taxel-icp", argc, argv);
   const Options opt = parse(args);
   taxel::io::PlyData source, target;
+  const std::string src_name = taxel_cli::input_name(opt.inputs[0]);
+  const std::string tgt_name = taxel_cli::input_name(opt.inputs[1]);
   try {
-    source = taxel::io::read_ply(opt.inputs[0]);
-    target = taxel::io::read_ply(opt.inputs[1]);
+    source = taxel::io::parse_ply(taxel_cli::read_input(opt.inputs[0]), src_name);
+    target = taxel::io::parse_ply(taxel_cli::read_input(opt.inputs[1]), tgt_name);
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }
@@ -172,18 +188,18 @@ int main(int argc, char** argv) {
       for (auto& p : cloud->points) p *= opt.scale;
     }
   }
-  taxel_cli::warn_if_millimetres("taxel-icp", opt.inputs[0],
+  taxel_cli::warn_if_millimetres("taxel-icp", src_name,
                                  taxel_cli::largest_extent(source.cloud.points));
-  taxel_cli::warn_if_millimetres("taxel-icp", opt.inputs[1],
+  taxel_cli::warn_if_millimetres("taxel-icp", tgt_name,
                                  taxel_cli::largest_extent(target.cloud.points));
   tr::ModelCloud model;
   try {  // a mesh becomes its surface (after scaling: the spacing is in metres)
     model = tr::model_cloud(std::move(target), {.spacing = opt.mesh_spacing});
   } catch (const std::invalid_argument& e) {
-    args.fail(opt.inputs[1] + ": " + e.what(), 1);
+    args.fail(tgt_name + ": " + e.what(), 1);
   }
   if (model.from_surface) {
-    std::fprintf(stderr, "taxel-icp: %s: %s\n", opt.inputs[1].c_str(), model.describe().c_str());
+    std::fprintf(stderr, "taxel-icp: %s: %s\n", tgt_name.c_str(), model.describe().c_str());
   }
   tr::IcpResult r;
   std::optional<tr::Target<double>> tg_storage;
@@ -191,7 +207,7 @@ int main(int argc, char** argv) {
     tg_storage.emplace(std::move(model.cloud),
                        tr::TargetConfig{.normal_neighbors = opt.normal_neighbors});
   } catch (const std::invalid_argument& e) {
-    args.fail(opt.inputs[1] + ": " + e.what(), 1);
+    args.fail(tgt_name + ": " + e.what(), 1);
   }
   const tr::Target<double>& tg = *tg_storage;
   try {
@@ -200,19 +216,35 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {  // a configuration Icp refuses
     args.fail(e.what());
   }
-  for (int row = 0; row < 4; ++row) {
-    std::printf("%.17g %.17g %.17g %.17g\n", r.transform(row, 0), r.transform(row, 1),
-                r.transform(row, 2), r.transform(row, 3));
+  std::string text;
+  if (opt.format == taxel_cli::Format::text) {
+    char line[160];
+    for (int row = 0; row < 4; ++row) {
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g\n", r.transform(row, 0),
+                    r.transform(row, 1), r.transform(row, 2), r.transform(row, 3));
+      text += line;
+    }
+    std::snprintf(line, sizeof line, "rmse %.9g\nfitness %.6f\niterations %d\nstatus %s\n", r.rmse,
+                  r.inlier_fraction, r.iterations, std::string(taxel::to_string(r.status)).c_str());
+    text += line;
+  } else {
+    taxel_cli::Json j = taxel_cli::pose_fields(r.transform);
+    j["rmse"] = r.rmse;
+    j["fitness"] = r.inlier_fraction;
+    j["iterations"] = r.iterations;
+    j["status"] = std::string(taxel::to_string(r.status));
+    j["skipped"] = r.skipped;
+    text = taxel_cli::render(j, opt.format);
   }
-  std::printf("rmse %.9g\nfitness %.6f\niterations %d\nstatus %s\n", r.rmse, r.inlier_fraction,
-              r.iterations, std::string(taxel::to_string(r.status)).c_str());
+  std::fwrite(text.data(), 1, text.size(), opt.output == "-" ? stderr : stdout);
   if (!r.ok()) std::fprintf(stderr, "taxel-icp: %s\n", r.message.c_str());
   if (r.skipped > 0) {
     std::fprintf(stderr, "taxel-icp: %zu non-finite source points skipped\n", r.skipped);
   }
   if (!opt.output.empty()) {
     try {
-      taxel::io::write_ply(opt.output, taxel::transformed(source.cloud, r.transform));
+      taxel_cli::write_output(opt.output,
+                              taxel::io::encode_ply(taxel::transformed(source.cloud, r.transform)));
     } catch (const std::exception& e) {
       args.fail(e.what(), 1);
     }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -40,13 +41,17 @@ options:
   --unknown D        answer unknown above this score (default 0.003)
   --gate D           points farther than D count as D in the score (default 0.01)
   --starts N         cube-rotation starts, 0..24 (default 24)
-  --format text|json (default text)
+  --format text|json|csv  how the result is printed (default text; csv: a row per model,
+                     best first, with its pose as translation, axis, angle and the 16 numbers
+                     of the transform, row-major)
   --scale F          multiply the cloud's and the models' coordinates by F first
                      (--scale 0.001 for files in millimetres)
   --mesh-spacing D   sample meshes at about one point per D^2 (default 0.001; 0: use
                      their vertices only)
   -h, --help         show this help
   --version          show taxel's version
+
+Lengths take a unit: 3mm, 0.3cm or 0.003 (metres). CLOUD may be - for standard input.
 
 Exit status: 0 when the cloud was ranked, 1 for unreadable input, 2 for bad options.
 )usage";
@@ -60,7 +65,7 @@ int main(int argc, char** argv) {
   const auto die = [&](const std::string& why, int code = 2) { args.fail(why, code); };
   constexpr double kInf = std::numeric_limits<double>::infinity();
   tr::LibraryConfig cfg;
-  bool json = false;
+  taxel_cli::Format format = taxel_cli::Format::text;
   double scale = 1.0;
   tr::ModelSampling sampling;
   std::vector<std::string> inputs;
@@ -70,19 +75,17 @@ int main(int argc, char** argv) {
       std::fputs(kUsage, stdout);
       return 0;
     } else if (a == "--unknown") {
-      cfg.unknown_score = args.number<double>(-kInf, kInf);
+      cfg.unknown_score = args.length(-kInf, kInf);
     } else if (a == "--gate") {
-      cfg.score_gate = args.number<double>(-kInf, kInf);
+      cfg.score_gate = args.length(-kInf, kInf);
     } else if (a == "--starts") {
       cfg.rotation_starts = args.number<int>(-1000, 1000);
     } else if (a == "--scale") {
       scale = args.number<double>(1e-300, 1e300);
     } else if (a == "--mesh-spacing") {
-      sampling.spacing = args.number<double>(0.0, 1e300);
+      sampling.spacing = args.length(0.0, 1e300);
     } else if (a == "--format") {
-      const auto v = args.value();
-      if (v != "text" && v != "json") die("--format must be text or json");
-      json = v == "json";
+      format = taxel_cli::to_format(args.choice("text|json|csv"));
     } else if (a.size() > 1 && a[0] == '-') {
       die("unknown option '" + std::string(a) + "' (see --help)");
     } else {
@@ -90,6 +93,9 @@ int main(int argc, char** argv) {
     }
   }
   if (inputs.size() < 2) die("expected CLOUD.ply and at least one MODEL (see --help)");
+  for (std::size_t k = 1; k < inputs.size(); ++k) {
+    if (inputs[k] == "-") die("only CLOUD can be standard input (-); the models are files");
+  }
 
   std::vector<fs::path> models;
   for (std::size_t k = 1; k < inputs.size(); ++k) {
@@ -118,8 +124,9 @@ int main(int argc, char** argv) {
   try {
     // Scaled, and checked for millimetres (a tactile object spans centimetres).
     // Meshes become their surface (after scaling: the spacing is in metres).
-    const auto load = [&](const std::string& path) {
-      taxel::io::PlyData ply = taxel::io::read_ply(path);
+    const auto load = [&](const std::string& file) {
+      const std::string path = taxel_cli::input_name(file);
+      taxel::io::PlyData ply = taxel::io::parse_ply(taxel_cli::read_input(file), path);
       if (scale != 1.0) {
         for (auto& p : ply.cloud.points) p *= scale;
       }
@@ -146,35 +153,42 @@ int main(int argc, char** argv) {
   } catch (const taxel::IoError& e) {
     die(e.what(), 1);
   }
-  if (!r.ok()) die(inputs[0] + ": " + r.message, 1);
+  if (!r.ok()) die(taxel_cli::input_name(inputs[0]) + ": " + r.message, 1);
 
+  if (format != taxel_cli::Format::text) {
+    // JSON: the answer and the ranking; CSV: a row per model, with the answer in each row.
+    taxel_cli::Json ranking = taxel_cli::Json::array();
+    for (std::size_t k = 0; k < r.ranking.size(); ++k) {
+      const auto& m = r.ranking[k];
+      taxel_cli::Json row = {{"rank", k + 1},    {"model", m.name}, {"score", m.score},
+                             {"exact", m.exact}, {"rmse", m.rmse},  {"fitness", m.inlier_fraction}};
+      row.update(taxel_cli::pose_fields(m.transform));
+      ranking.push_back(std::move(row));
+    }
+    std::string text;
+    if (format == taxel_cli::Format::json) {
+      text = taxel_cli::render({{"best", r.best},
+                                {"unknown", r.unknown},
+                                {"margin", r.margin},
+                                {"ranking", std::move(ranking)}},
+                               format);
+    } else {
+      for (auto& row : ranking) {
+        row["best"] = r.best;
+        row["unknown"] = r.unknown;
+        row["margin"] = r.margin;
+      }
+      text = taxel_cli::render(ranking, format);
+    }
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return 0;
+  }
   // T_model_cloud as translation [m] and axis-angle (unit axis, angle [rad]).
   const auto axis_angle = [](const taxel::Isometry3d& t) {
     const Eigen::AngleAxisd aa(t.linear());
     return std::pair<taxel::Vec3d, double>(aa.angle() > 0.0 ? aa.axis() : taxel::Vec3d::UnitZ(),
                                            aa.angle());
   };
-  if (json) {
-    std::printf("{\"best\": \"%s\", \"unknown\": %s, \"margin\": %.9g, \"ranking\": [",
-                taxel_cli::json_escape(r.best).c_str(), r.unknown ? "true" : "false", r.margin);
-    for (std::size_t k = 0; k < r.ranking.size(); ++k) {
-      const auto& m = r.ranking[k];
-      const auto [axis, angle] = axis_angle(m.transform);
-      const taxel::Vec3d t = m.transform.translation();
-      std::printf(
-          "%s\n  {\"model\": \"%s\", \"score\": %.9g, \"rmse\": %.9g, \"fitness\": %.6f, "
-          "\"translation\": [%.9g, %.9g, %.9g], \"axis\": [%.9g, %.9g, %.9g], "
-          "\"angle\": %.9g, \"transform\": [",
-          k ? "," : "", taxel_cli::json_escape(m.name).c_str(), m.score, m.rmse, m.inlier_fraction,
-          t.x(), t.y(), t.z(), axis.x(), axis.y(), axis.z(), angle);
-      for (int i = 0; i < 16; ++i) {
-        std::printf("%s%.17g", i ? ", " : "", m.transform.matrix()(i / 4, i % 4));
-      }
-      std::printf("]}");
-    }
-    std::printf("\n]}\n");
-    return 0;
-  }
   std::printf("%-4s %-32s %10s %10s %8s\n", "rank", "model", "score_mm", "rmse_mm", "fitness");
   for (std::size_t k = 0; k < r.ranking.size(); ++k) {
     const auto& m = r.ranking[k];

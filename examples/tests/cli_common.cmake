@@ -55,3 +55,13 @@ function(expect_version tool name)
   run_tool("${tool}" 0 --version)
   expect("${out}" "^${name} \\(taxel\\) [0-9]+\\.[0-9]+\\.[0-9]+\n$")
 endfunction()
+
+# Sets `var` to the number of elements of the array (or members of the object) at ARGN in the
+# JSON `text`; fails when the text is not JSON or the member is missing.
+function(json_length var text)
+  string(JSON value ERROR_VARIABLE json_error LENGTH "${text}" ${ARGN})
+  if(json_error)
+    message(FATAL_ERROR "not valid JSON, or no member ${ARGN}: ${json_error}\n${text}")
+  endif()
+  set(${var} "${value}" PARENT_SCOPE)
+endfunction()
