@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <charconv>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -50,6 +51,11 @@ inline std::string scalar(const Json& v, bool csv) {
       q += c;
     }
     return q + "\"";
+  }
+  if (v.is_number_float()) {  // shortest round trip: 128, not 128.0; nan and inf as words
+    char buf[32];
+    const auto res = std::to_chars(buf, buf + sizeof buf, v.get<double>());
+    return std::string(buf, res.ptr);
   }
   if (v.is_structured()) return v.dump(-1, ' ', false, Json::error_handler_t::replace);
   return v.dump();

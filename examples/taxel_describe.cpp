@@ -18,6 +18,7 @@
 #endif
 
 #include "cli.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -37,7 +38,8 @@ per frame, its label from --labels, then the 11 regional features (conventional 
 or, with --hybrid, the 1035-long hybrid vector.
 
 options:
-  --format csv|json|libsvm  output format (default csv)
+  --format csv|json|text|libsvm  output format (default csv; text: "name value" lines per
+                        frame, frames separated by a blank line)
   --labels FILE         one integer label per frame, first token of each line ('#' comments
                         and blank lines skipped); required by --format libsvm
   --hybrid              also print the hybrid feature vector (rows*cols + 11 values)
@@ -49,10 +51,13 @@ options:
   -o FILE               write to FILE instead of standard output
   -h, --help            show this help
   --version             show taxel's version
+
+IMAGE may be - for standard input; its format is then told by its first bytes (NPY, PGM,
+PNG, else text). Nothing is written unless every frame was read and described.
 )";
 
 struct Options {
-  bool json = false;
+  taxel_cli::Format format = taxel_cli::Format::csv;
   bool libsvm = false;
   std::string labels;
   bool hybrid = false;
@@ -79,10 +84,9 @@ Options parse(int argc, char** argv) {
       std::fputs(kUsage, stdout);
       std::exit(0);
     } else if (a == "--format") {
-      const auto v = value();
-      if (v != "csv" && v != "json" && v != "libsvm") die("--format must be csv, json or libsvm");
-      o.json = v == "json";
+      const auto v = args.choice("csv|json|text|libsvm");
       o.libsvm = v == "libsvm";
+      if (!o.libsvm) o.format = taxel_cli::to_format(v);
     } else if (a == "--labels") {
       o.labels = std::string(value());
     } else if (a == "--hybrid") {
@@ -113,15 +117,12 @@ Options parse(int argc, char** argv) {
     }
   }
   if (o.inputs.empty()) die("no input image (see --help)");
+  if (std::count(o.inputs.begin(), o.inputs.end(), "-") > 1) {
+    die("only one input can be standard input (-)");
+  }
   if (o.libsvm && o.labels.empty()) die("--format libsvm needs --labels FILE");
   if (!o.libsvm && !o.labels.empty()) die("--labels is only used with --format libsvm");
   return o;
-}
-
-std::string fmt(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return {buf, res.ptr};
 }
 
 constexpr const char* kExtra[] = {"MajorAxisLength", "MinorAxisLength", "Solidity", "Extent",
@@ -153,16 +154,32 @@ std::vector<int> read_labels(const std::string& path) {
   return labels;
 }
 
-// An image file: .png through libpng when built with it, the rest by io::read_image.
+// An image file: .png through libpng when built with it, the rest by io::read_image; standard
+// input ("-") by its first bytes.
 taxel::io::ImageStack load_image(const std::string& path) {
-  if (taxel::io::extension(path) == ".png") {
+  std::string ext = taxel::io::extension(path);
+  std::string bytes;
+  if (path == "-") {
+    bytes = taxel_cli::read_input(path);
+    const std::string_view b(bytes);
+    ext = b.starts_with("\x93NUMPY")                   ? ".npy"
+          : b.starts_with("P2") || b.starts_with("P5") ? ".pgm"
+          : b.starts_with("\x89PNG")                   ? ".png"
+                                                       : ".csv";
+  }
+  const std::string name = taxel_cli::input_name(path);
+  if (ext == ".png") {
 #ifdef TAXEL_DESCRIBE_HAVE_PNG
+    if (path == "-") return taxel::io::decode_png_image(bytes, name);
     return taxel::io::read_png_image(path);
 #else
-    throw taxel::IoError(path, "PNG input needs taxel-describe built with libpng");
+    throw taxel::IoError(name, "PNG input needs taxel-describe built with libpng");
 #endif
   }
-  return taxel::io::read_image(path);
+  if (path != "-") return taxel::io::read_image(path);
+  if (ext == ".npy") return taxel::io::parse_npy(bytes, name);
+  if (ext == ".pgm") return taxel::io::parse_pgm(bytes, name);
+  return taxel::io::parse_image_csv(bytes, name);
 }
 
 // --format libsvm: every frame's features with its label.
@@ -176,7 +193,7 @@ std::string describe_libsvm(const Options& opt) {
     for (Eigen::Index f = 0; f < stack.frames; ++f) {
       const ti::Recognition& r = rec.recognize(stack.frame(f));
       if (!r.ok()) {
-        bad_data(path + " frame " + std::to_string(f) + ": " +
+        bad_data(taxel_cli::input_name(path) + " frame " + std::to_string(f) + ": " +
                  std::string(taxel::to_string(r.status)) + ": " + r.message);
       }
       rows.push_back(opt.hybrid ? r.hybrid : r.regional);
@@ -205,66 +222,46 @@ int main(int argc, char** argv) try {
   std::string out;
   if (opt.libsvm) {
     out = describe_libsvm(opt);
-  } else if (!opt.json) {
-    out = "file,frame,status,edged,Gm";
-    for (const auto name : ti::kEdgeFeatureNames) out += "," + std::string(name);
-    for (const char* name : kExtra) out += std::string(",") + name;
-    out += opt.hybrid ? ",hybrid...\n" : "\n";
   } else {
-    out = "[\n";
-  }
-  bool first = true;
-  for (const std::string& path : opt.libsvm ? std::vector<std::string>{} : opt.inputs) {
-    const taxel::io::ImageStack stack = load_image(path);
-    ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg, ti::GradientThreshold{opt.threshold});
-    ti::RegionAnalyzer props({}, stack.rows, stack.cols);
-    for (Eigen::Index f = 0; f < stack.frames; ++f) {
-      const ti::Recognition& r = rec.recognize(stack.frame(f));
-      const ti::RegionProps& p = props.compute(rec.segmentation().high);
-      const double extra[] = {p.major_axis, p.minor_axis,     p.solidity,
-                              p.extent,     p.equiv_diameter, static_cast<double>(p.euler_number4),
-                              p.perimeter};
-      std::string status(taxel::to_string(r.status));
-      if (!opt.json) {
-        std::string line = path + "," + std::to_string(f) + "," + status + "," +
-                           (r.edged ? "1" : "0") + "," + fmt(r.contour_gradient);
-        for (Eigen::Index i = 0; i < r.edge_features.size(); ++i) {
-          line += "," + fmt(r.edge_features(i));
+    taxel_cli::Json records = taxel_cli::Json::array();
+    for (const std::string& path : opt.inputs) {
+      const taxel::io::ImageStack stack = load_image(path);
+      ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg, ti::GradientThreshold{opt.threshold});
+      ti::RegionAnalyzer props({}, stack.rows, stack.cols);
+      for (Eigen::Index f = 0; f < stack.frames; ++f) {
+        const ti::Recognition& r = rec.recognize(stack.frame(f));
+        const ti::RegionProps& p = props.compute(rec.segmentation().high);
+        const double extra[] = {p.major_axis,     p.minor_axis,
+                                p.solidity,       p.extent,
+                                p.equiv_diameter, static_cast<double>(p.euler_number4),
+                                p.perimeter};
+        taxel_cli::Json row = {{"file", taxel_cli::input_name(path)},
+                               {"frame", f},
+                               {"status", std::string(taxel::to_string(r.status))}};
+        if (opt.format == taxel_cli::Format::json && !r.ok()) row["message"] = r.message;
+        row["edged"] = opt.format == taxel_cli::Format::csv ? taxel_cli::Json(r.edged ? 1 : 0)
+                                                            : taxel_cli::Json(r.edged);
+        row["Gm"] = r.contour_gradient;
+        taxel_cli::Json features = taxel_cli::Json::object();
+        for (std::size_t i = 0; i < ti::kEdgeFeatureNames.size(); ++i) {
+          features[std::string(ti::kEdgeFeatureNames[i])] =
+              r.edge_features(static_cast<Eigen::Index>(i));
         }
-        for (double v : extra) line += "," + fmt(v);
+        for (std::size_t i = 0; i < std::size(kExtra); ++i) features[kExtra[i]] = extra[i];
+        if (opt.format == taxel_cli::Format::json) {
+          row["features"] = std::move(features);
+        } else {  // flat columns, as the CSV header has always named them
+          row.update(features);
+        }
         if (opt.hybrid) {
-          for (Eigen::Index i = 0; i < r.hybrid.size(); ++i) line += "," + fmt(r.hybrid(i));
+          row["hybrid"] = std::vector<double>(r.hybrid.data(), r.hybrid.data() + r.hybrid.size());
         }
-        out.append(line).append("\n");
-        continue;
+        records.push_back(std::move(row));
       }
-      std::string obj = first ? "  {" : ",\n  {";
-      first = false;
-      obj += "\"file\": \"" + taxel_cli::json_escape(path) + "\", \"frame\": " + std::to_string(f) +
-             ", \"status\": \"" + status + "\"";
-      if (!r.ok()) obj += ", \"message\": \"" + taxel_cli::json_escape(r.message) + "\"";
-      obj += std::string(", \"edged\": ") + (r.edged ? "true" : "false") +
-             ", \"Gm\": " + fmt(r.contour_gradient) + ", \"features\": {";
-      for (std::size_t i = 0; i < ti::kEdgeFeatureNames.size(); ++i) {
-        obj += (i ? ", \"" : "\"") + std::string(ti::kEdgeFeatureNames[i]) +
-               "\": " + fmt(r.edge_features(static_cast<Eigen::Index>(i)));
-      }
-      for (std::size_t i = 0; i < std::size(kExtra); ++i) {
-        obj += std::string(", \"") + kExtra[i] + "\": " + fmt(extra[i]);
-      }
-      obj += "}";
-      if (opt.hybrid) {
-        obj += ", \"hybrid\": [";
-        for (Eigen::Index i = 0; i < r.hybrid.size(); ++i)
-          obj += (i ? ", " : "") + fmt(r.hybrid(i));
-        obj += "]";
-      }
-      obj += "}";
-      out += obj;
     }
+    out = taxel_cli::render(records, opt.format);
   }
-  if (opt.json && !opt.libsvm) out += "\n]\n";
-  if (opt.output.empty()) {
+  if (opt.output.empty() || opt.output == "-") {
     std::fwrite(out.data(), 1, out.size(), stdout);  // checked at exit
   } else {
     taxel::io::write_file(opt.output, out);

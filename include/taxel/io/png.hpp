@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "taxel/core/error.hpp"
 #include "taxel/io/image.hpp"
@@ -59,8 +60,11 @@ inline RgbImage read_png(const std::string& path) {
 /// IoError for an unreadable file, a colour image or one with an alpha channel, naming the
 /// file.
 template <class = void>
-inline ImageStack read_png_image(const std::string& path) {
-  const std::string bytes = read_file(path);
+inline ImageStack read_png_image(const std::string& path);
+
+/// As read_png_image, from the bytes of a PNG file in memory; `path` names it in errors.
+template <class = void>
+inline ImageStack decode_png_image(std::string_view bytes, const std::string& path = "<png>") {
   png_image desc{};
   desc.version = PNG_IMAGE_VERSION;
   if (png_image_begin_read_from_memory(&desc, bytes.data(), bytes.size()) == 0) {
@@ -103,6 +107,11 @@ inline ImageStack read_png_image(const std::string& path) {
     out.values[i] = wide ? double(wide_samples[i]) : double(narrow_samples[i]);
   }
   return out;
+}
+
+template <class>
+inline ImageStack read_png_image(const std::string& path) {
+  return decode_png_image(read_file(path), path);
 }
 
 }  // namespace taxel::io
