@@ -5,12 +5,15 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <taxel/io.hpp>
 #include <taxel/learn.hpp>
+#include <utility>
 
 #include "cli.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -21,6 +24,8 @@ constexpr const char* kUsage =
 options:
 -q : quiet mode (no outputs)
 --max-values n : largest dense data set read, samples x features (default 16777216)
+--format text|json|csv : how the accuracy is printed (default text, as LIBLINEAR's predict;
+	 json and csv give accuracy (a fraction), correct and total)
 -h, --help : show this help
 --version : show the version
 
@@ -30,7 +35,8 @@ solver). As LIBLINEAR does, features beyond the model's nr_feature are ignored. 
 is refused: LIBLINEAR gives them only for logistic-regression models.
 
 Exit status: 0 on success, 1 for unreadable data or model (or an output that cannot be
-written), 2 for bad options.
+written), 2 for bad options. Long options also take --name=value. test_file may be - for
+standard input, output_file - for standard output (the accuracy then goes to standard error).
 )usage";
 
 // Bad options exit 2, bad data 1.
@@ -46,18 +52,35 @@ int main(int argc, char** argv) {
   taxel_cli::print_version_if_asked("taxel-predict", argc, argv);
   try {
     bool quiet = false;
+    taxel_cli::Format format = taxel_cli::Format::text;
     std::vector<std::string> files;
     taxel::io::LibsvmReadOptions read_opt;
     for (int i = 1; i < argc; ++i) {
-      const std::string_view a = argv[i];
+      std::string_view a = argv[i];
+      std::optional<std::string_view> inline_value;  // --name=value
+      if (a.starts_with("--") && a.find('=') != std::string_view::npos) {
+        inline_value = a.substr(a.find('=') + 1);
+        a = a.substr(0, a.find('='));
+      }
+      const auto value = [&]() -> std::string_view {
+        if (inline_value) return *std::exchange(inline_value, std::nullopt);
+        if (i + 1 >= argc) fail(std::string(a) + " needs a value", 2);
+        return argv[++i];
+      };
       if (a == "-h" || a == "--help") {
         std::fputs(kUsage, stdout);
         return 0;
       }
       if (a == "-q") {
         quiet = true;
+      } else if (a == "--format") {
+        const std::string_view v = value();
+        if (v != "text" && v != "json" && v != "csv") {
+          fail("--format must be one of text,json,csv, not '" + std::string(v) + "'", 2);
+        }
+        format = taxel_cli::to_format(v);
       } else if (a == "--max-values") {
-        const std::string_view t = i + 1 < argc ? argv[++i] : "";
+        const std::string_view t = value();
         std::uint64_t v = 0;
         const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
         if (r.ec != std::errc{} || r.ptr != t.data() + t.size() || v == 0) {
@@ -74,13 +97,16 @@ int main(int argc, char** argv) {
       } else {
         files.emplace_back(a);
       }
+      if (inline_value) fail(std::string(a) + " takes no value", 2);
     }
     if (files.size() != 3) {
       std::fputs(kUsage, stderr);
       return 2;
     }
+    if (files[1] == "-") fail("model_file must be a file, not standard input", 2);
     const tl::LinearSvm model = tl::LinearSvm::load(taxel::io::read_file(files[1]), files[1]);
-    tl::Dataset test = taxel::io::read_libsvm(files[0], read_opt);
+    tl::Dataset test = taxel::io::parse_libsvm(taxel_cli::read_input(files[0]),
+                                               taxel_cli::input_name(files[0]), read_opt);
     if (test.dims() != model.dims()) {  // LIBLINEAR ignores extra features; absent ones are 0
       tl::FeatureMatrix x = tl::FeatureMatrix::Zero(test.rows(), model.dims());
       const Eigen::Index common = std::min(test.dims(), model.dims());
@@ -94,11 +120,21 @@ int main(int argc, char** argv) {
       correct += label == test.y[static_cast<std::size_t>(i)] ? 1 : 0;
       out.append(std::to_string(label)).append("\n");
     }
-    taxel::io::write_file(files[2], out);
+    taxel_cli::write_output(files[2], out);
     if (!quiet) {
-      std::printf("Accuracy = %g%% (%zu/%zu)\n",
-                  100.0 * static_cast<double>(correct) / static_cast<double>(test.rows()), correct,
-                  static_cast<std::size_t>(test.rows()));
+      const auto total = static_cast<std::size_t>(test.rows());
+      const double accuracy = static_cast<double>(correct) / static_cast<double>(total);
+      std::string text;
+      if (format == taxel_cli::Format::text) {
+        char line[96];
+        std::snprintf(line, sizeof line, "Accuracy = %g%% (%zu/%zu)\n", 100.0 * accuracy, correct,
+                      total);
+        text = line;
+      } else {
+        text = taxel_cli::render({{"accuracy", accuracy}, {"correct", correct}, {"total", total}},
+                                 format);
+      }
+      std::fwrite(text.data(), 1, text.size(), files[2] == "-" ? stderr : stdout);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -12,8 +12,10 @@
 #include <string_view>
 #include <taxel/io.hpp>
 #include <taxel/learn.hpp>
+#include <utility>
 
 #include "cli.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -37,12 +39,18 @@ options:
 --grouped : with -v, keep each qid group in one fold
 --max-iter n : outer iterations per binary problem (default 1000, as LIBLINEAR 2.3)
 --max-values n : largest dense data set read, samples x features (default 16777216)
+--format text|json|csv : how results are printed (default text, as LIBLINEAR's train; json
+	 and csv give the cross-validation accuracy (a fraction), the -C grid, or per binary
+	 problem the iterations, objective and support vectors)
 -h, --help : show this help
 --version : show the version
 
 Exit status: 0 on success, 1 for unreadable or unusable data (and a model file that cannot be
 written), 2 for bad options. -b (probability estimates) is refused: LIBLINEAR gives them only
 for logistic regression, and taxel-train's solvers are SVMs.
+
+Long options also take --name=value. training_set_file may be - for standard input, and
+model_file - for standard output (what would be printed then goes to standard error).
 
 The model file is LIBLINEAR's text format (default: <training_set_file basename>.model in the
 current directory); LIBLINEAR's predict and taxel-predict both read it.
@@ -55,9 +63,8 @@ current directory); LIBLINEAR's predict and taxel-predict both read it.
 }
 [[noreturn]] void usage_error(const std::string& why) { fail(why, 2); }
 
-double number(std::string_view opt, const char* text) {
+double number(std::string_view opt, std::string_view t) {
   double v = 0.0;
-  const std::string_view t(text);
   const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
   if (r.ec != std::errc{} || r.ptr != t.data() + t.size()) {
     usage_error("option " + std::string(opt) + " expects a number, got '" + std::string(t) + "'");
@@ -83,10 +90,17 @@ int main(int argc, char** argv) {
     bool search_c = false;
     std::string data_file;
     std::string model_file;
+    taxel_cli::Format format = taxel_cli::Format::text;
     taxel::io::LibsvmReadOptions read_opt;
     for (int i = 1; i < argc; ++i) {
-      const std::string_view a = argv[i];
-      const auto value = [&]() -> const char* {
+      std::string_view a = argv[i];
+      std::optional<std::string_view> inline_value;  // --name=value
+      if (a.starts_with("--") && a.find('=') != std::string_view::npos) {
+        inline_value = a.substr(a.find('=') + 1);
+        a = a.substr(0, a.find('='));
+      }
+      const auto value = [&]() -> std::string_view {
+        if (inline_value) return *std::exchange(inline_value, std::nullopt);
         if (i + 1 >= argc) usage_error("option " + std::string(a) + " needs a value");
         return argv[++i];
       };
@@ -120,6 +134,12 @@ int main(int argc, char** argv) {
         const double v = number(a, value());
         if (!(v >= 1.0 && v <= 1e18)) usage_error("--max-values must be in [1, 1e18]");
         read_opt.max_values = static_cast<std::uint64_t>(v);
+      } else if (a == "--format") {
+        const std::string_view v = value();
+        if (v != "text" && v != "json" && v != "csv") {
+          usage_error("--format must be one of text,json,csv, not '" + std::string(v) + "'");
+        }
+        format = taxel_cli::to_format(v);
       } else if (a == "--grouped") {
         grouped = true;
       } else if (a == "-C") {
@@ -146,6 +166,7 @@ int main(int argc, char** argv) {
       } else {
         usage_error("too many arguments (see --help)");
       }
+      if (inline_value) usage_error(std::string(a) + " takes no value");
     }
     if (data_file.empty()) {
       std::fputs(kUsage, stderr);
@@ -158,7 +179,18 @@ int main(int argc, char** argv) {
       usage_error(e.what());
     }
     const tl::LinearSvm& prototype = *checked;
-    const tl::Dataset data = taxel::io::read_libsvm(data_file, read_opt);
+    const tl::Dataset data = taxel::io::parse_libsvm(taxel_cli::read_input(data_file),
+                                                     taxel_cli::input_name(data_file), read_opt);
+    if (data_file == "-" && model_file.empty() && !search_c && folds == 0) {
+      usage_error(
+          "with the training set on standard input, name the model_file (- for "
+          "standard output)");
+    }
+    // Results go to standard output, or to standard error when the model goes there.
+    FILE* const report_to = model_file == "-" ? stderr : stdout;
+    const auto emit = [&](const std::string& text) {
+      std::fwrite(text.data(), 1, text.size(), report_to);
+    };
 
     if (search_c) {
       // LIBLINEAR's -C searches upwards from a small C with warm starts, for its primal
@@ -168,6 +200,7 @@ int main(int argc, char** argv) {
       opt.seed = cfg.seed;
       opt.grouped = grouped;
       double best_c = 0.0, best_accuracy = -1.0;
+      taxel_cli::Json grid = taxel_cli::Json::array();
       for (int e = -10; e <= 10; ++e) {
         tl::LinearSvmConfig c = cfg;
         c.C = std::ldexp(1.0, e);
@@ -175,13 +208,27 @@ int main(int argc, char** argv) {
         if (r.status == taxel::Status::invalid_input || r.status == taxel::Status::degenerate) {
           fail(data_file + ": " + r.message);
         }
-        if (!quiet) std::printf("log2c= %3d\trate= %g\n", e, 100.0 * r.accuracy);
+        if (!quiet && format == taxel_cli::Format::text) {
+          std::fprintf(report_to, "log2c= %3d\trate= %g\n", e, 100.0 * r.accuracy);
+        }
+        grid.push_back({{"log2c", e}, {"C", c.C}, {"accuracy", r.accuracy}});
         if (r.accuracy > best_accuracy) {
           best_accuracy = r.accuracy;
           best_c = c.C;
         }
       }
-      std::printf("Best C = %g  CV accuracy = %g%%\n", best_c, 100.0 * best_accuracy);
+      if (format == taxel_cli::Format::text) {
+        std::fprintf(report_to, "Best C = %g  CV accuracy = %g%%\n", best_c, 100.0 * best_accuracy);
+      } else if (format == taxel_cli::Format::json) {
+        emit(taxel_cli::render({{"best_c", best_c},
+                                {"accuracy", best_accuracy},
+                                {"folds", opt.folds},
+                                {"grid", std::move(grid)}},
+                               format));
+      } else {  // a row per C of the grid, the chosen one marked
+        for (auto& row : grid) row["best"] = row["C"].get<double>() == best_c;
+        emit(taxel_cli::render(grid, format));
+      }
       return 0;
     }
 
@@ -200,7 +247,11 @@ int main(int argc, char** argv) {
         fail(data_file + ": " + r.message);
       }
       if (!r.ok() && !quiet) std::fprintf(stderr, "taxel-train: warning: %s\n", r.message.c_str());
-      std::printf("Cross Validation Accuracy = %g%%\n", 100.0 * r.accuracy);
+      if (format == taxel_cli::Format::text) {
+        std::fprintf(report_to, "Cross Validation Accuracy = %g%%\n", 100.0 * r.accuracy);
+      } else {
+        emit(taxel_cli::render({{"folds", folds}, {"accuracy", r.accuracy}}, format));
+      }
       return 0;
     }
 
@@ -209,16 +260,33 @@ int main(int argc, char** argv) {
     if (o.status == taxel::Status::invalid_input || o.status == taxel::Status::degenerate) {
       fail(data_file + ": " + o.message);
     }
+    if (model_file.empty()) model_file = basename(data_file) + ".model";
+    taxel_cli::write_output(model_file, model.save());
     if (!quiet) {
       const tl::LinearSvmTrainInfo& info = model.info();
+      taxel_cli::Json problems = taxel_cli::Json::array();
       for (std::size_t k = 0; k < info.iterations.size(); ++k) {
-        std::printf("optimization finished, #iter = %d\nObjective value = %f\nnSV = %d\n",
-                    info.iterations[k], info.objective[k], info.support_vectors[k]);
+        if (format == taxel_cli::Format::text) {
+          std::fprintf(report_to,
+                       "optimization finished, #iter = %d\nObjective value = %f\nnSV = %d\n",
+                       info.iterations[k], info.objective[k], info.support_vectors[k]);
+        }
+        problems.push_back({{"problem", k},
+                            {"iterations", info.iterations[k]},
+                            {"objective", info.objective[k]},
+                            {"support_vectors", info.support_vectors[k]}});
+      }
+      if (format == taxel_cli::Format::json) {
+        emit(taxel_cli::render({{"model_file", model_file == "-" ? "<stdout>" : model_file},
+                                {"classes", model.classes()},
+                                {"features", model.dims()},
+                                {"problems", std::move(problems)}},
+                               format));
+      } else if (format == taxel_cli::Format::csv) {
+        emit(taxel_cli::render(problems, format));
       }
       if (!o.ok()) std::fprintf(stderr, "taxel-train: warning: %s\n", o.message.c_str());
     }
-    if (model_file.empty()) model_file = basename(data_file) + ".model";
-    taxel::io::write_file(model_file, model.save());
     return 0;
   } catch (const std::exception& e) {
     fail(e.what());
