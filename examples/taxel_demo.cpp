@@ -12,8 +12,10 @@
 //   taxel-demo [--quick] [OUTPUT-FOLDER]      (default taxel-demo-output)
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <functional>
+#include <numbers>
 #include <random>
 #include <string>
 #include <string_view>
@@ -31,6 +33,7 @@
 #endif
 
 #include "cli.hpp"
+#include "demo_viewer.hpp"
 
 namespace {
 
@@ -69,13 +72,20 @@ struct Page {
     body.append("<figure><img src=\"").append(file).append("\" alt=\"").append(caption);
     body.append("\"><figcaption>").append(caption).append("</figcaption></figure>\n");
   }
-  void links(const std::vector<std::string>& files) {
-    body += "<p class=\"files\">";
-    for (const auto& f : files)
-      body.append("<a href=\"").append(f).append("\">").append(f).append("</a> ");
+  void raw(const std::string& html) { body += html; }
+  // Links that download (PLY is binary: a browser would show it as text).
+  void links(const std::vector<std::string>& files, const fs::path& dir) {
+    body += "<p class=\"files\">PLY files (binary; MeshLab, CloudCompare, Open3D, taxel's io): ";
+    for (const auto& f : files) {
+      std::error_code ec;
+      const auto bytes = fs::file_size(dir / f, ec);
+      body.append("<a download href=\"").append(f).append("\">").append(f).append("</a>");
+      if (!ec) body.append(" (").append(std::to_string((bytes + 1023) / 1024)).append(" KiB)");
+      body += " ";
+    }
     body += "</p>\n";
   }
-  std::string html(const std::string& summary) const {
+  std::string html(const std::string& summary, const std::string& stamp) const {
     std::string h =
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n"
         "<title>taxel demo</title>\n<style>\n"
@@ -85,10 +95,15 @@ struct Page {
         "text-align:right}th{background:#eee}figure{display:inline-block;margin:.5em;"
         "vertical-align:top}figcaption{font-size:.9em;color:#555;max-width:32em}"
         "img{max-width:100%;border:1px solid #ddd}.files a{margin-right:.8em;font-size:.9em}\n"
-        "#image-check{color:#555;font-size:.9em}\n"
+        ".checks{display:none}footer{color:#666;font-size:.85em;margin-top:2em;border-top:1px "
+        "solid "
+        "#ddd;padding-top:.5em}.labels{display:flex;gap:8px;font-size:.85em;margin-left:calc(.5em "
+        "+ 1px)}"
+        ".labels span{width:192px;text-align:center}\n"
         "</style></head><body>\n<h1>taxel: tactile perception, end to end</h1>\n<p>" +
-        summary + "</p>\n" + body +
-        "<p id=\"image-check\">checking pictures...</p>\n"
+        summary + "</p>\n" + taxel_demo::viewer_script() + body + "<footer>" + stamp +
+        "</footer>\n<div class=\"checks\"><p id=\"image-check\">checking pictures...</p>"
+        "<p id=\"view-check\">checking 3-D views...</p></div>\n"
         "<script>\n"
         "window.addEventListener('load', () => {\n"
         "  const imgs = Array.from(document.images);\n"
@@ -97,6 +112,13 @@ struct Page {
         "  p.textContent = broken.length ? 'broken pictures: ' + broken.join(' ')\n"
         "                                : 'all ' + imgs.length + ' pictures loaded';\n"
         "  p.dataset.status = broken.length ? 'broken' : 'ok';\n"
+        "  const views = Array.from(document.querySelectorAll('canvas.cloud3d'));\n"
+        "  views.forEach(c => { try { taxelView(c); } catch (e) { c.dataset.status = e; } });\n"
+        "  const blank = views.filter(c => !(Number(c.dataset.inked) > 200)).map(c => c.id);\n"
+        "  const v = document.getElementById('view-check');\n"
+        "  v.textContent = blank.length ? 'blank 3-D views: ' + blank.join(' ')\n"
+        "                               : views.length + ' 3-D views rendered';\n"
+        "  v.dataset.status = blank.length ? 'blank' : 'ok';\n"
         "});\n</script>\n</body></html>\n";
     return h;
   }
@@ -118,6 +140,19 @@ std::string write_picture(const fs::path& dir, const std::string& stem, const io
   io::write_file((dir / name).string(), io::encode_ppm(pic));
 #endif
   return name;
+}
+
+// A horizontal colour bar of taxel's ramp, labelled at both ends.
+std::string colour_bar(const std::string& what, const std::string& lo, const std::string& hi) {
+  std::string stops;
+  for (int k = 0; k <= 10; ++k) {
+    const auto c = io::ramp(k / 10.0);
+    stops += (k ? "," : "") + std::string("rgb(") + std::to_string(c[0]) + "," +
+             std::to_string(c[1]) + "," + std::to_string(c[2]) + ")";
+  }
+  return "<div class=\"view3d\"><div class=\"bar\"><span>" + what + ": " + lo +
+         "</span><div style=\"background:linear-gradient(to right," + stops + ")\"></div><span>" +
+         hi + "</span></div></div>\n";
 }
 
 // ---- 1. fusion ---------------------------------------------------------------------------------
@@ -162,8 +197,45 @@ std::vector<Contact<double>> explore(const Shape& shape, const Isometry3d& pose,
   return all;
 }
 
+// The rotations that map an object onto itself, for pose errors that do not blame a symmetric
+// object's arbitrary turn: a sphere any, a cylinder any about its axis and a half turn across
+// it, a cone any about its axis, a box the half turns about its axes, a cube the 24 rotations
+// of the cube.
+enum class Symmetry { sphere, cylinder, cone, box, cube };
+
+// The angle [deg] between R (identity when the pose is right) and the nearest symmetry; NaN for
+// a sphere, whose rotation is not defined.
+double rotation_error_deg(const Eigen::Matrix3d& R, Symmetry s) {
+  const double deg = 180.0 / std::numbers::pi;
+  const auto acos_deg = [&](double c) { return std::acos(std::clamp(c, -1.0, 1.0)) * deg; };
+  switch (s) {
+    case Symmetry::sphere:
+      return std::numeric_limits<double>::quiet_NaN();
+    case Symmetry::cone:
+      return acos_deg(R(2, 2));
+    case Symmetry::cylinder:
+      return acos_deg(std::abs(R(2, 2)));
+    default:
+      break;
+  }
+  double best = 180.0;
+  // Signed permutation matrices of determinant +1 (the cube's 24); a box keeps the diagonal 4.
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (const auto& p : perms) {
+    if (s == Symmetry::box && !(p[0] == 0 && p[1] == 1)) continue;
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+      for (int r = 0; r < 3; ++r) S(r, p[r]) = (signs >> r & 1) ? -1.0 : 1.0;
+      if (S.determinant() < 0) continue;
+      best = std::min(best, Eigen::AngleAxisd(R * S.transpose()).angle() * deg);
+    }
+  }
+  return best;
+}
+
 struct Object {
   std::string name;
+  Symmetry symmetry = Symmetry::sphere;
   std::function<std::vector<Contact<double>>(const Isometry3d&, bool, std::uint64_t)> explore;
   std::function<PointCloud<double>(std::size_t)> model;
   std::function<std::vector<FusionRow>(const std::vector<Contact<double>>&, const fs::path&,
@@ -174,9 +246,10 @@ struct Object {
 };
 
 template <class Shape>
-Object make_object(std::string name, Shape shape) {
+Object make_object(std::string name, Shape shape, Symmetry symmetry) {
   Object o;
   o.name = name;
+  o.symmetry = symmetry;
   o.explore = [shape](const Isometry3d& pose, bool quick, std::uint64_t seed) {
     return explore(shape, pose, quick, seed);
   };
@@ -218,7 +291,7 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
   std::printf("%-16s %-8s %8s %7s %8s %8s %8s %7s %8s %10s\n", "object", "policy", "contacts",
               "points", "compact", "mean mm", "rms mm", "max mm", "cover", "signed mm");
   std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> files;
+  std::vector<std::string> files, views;
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const Object& o = objects[i];
     const auto contacts = o.explore(Isometry3d::Identity(), quick, 100 + i);
@@ -239,8 +312,20 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
     view.title = o.name + ": Surfel cloud, " + std::to_string(kalman.size()) + " points";
     view.value_label = "error mm";
     view.value_min = 0.0;
+    const std::vector<double> err = o.distances(kalman.points);
     io::write_file((out / (o.name + "_kalman.svg")).string(),
-                   io::render_cloud_svg(kalman.points, o.distances(kalman.points), view));
+                   io::render_cloud_svg(kalman.points, err, view));
+    // The colour scale: up to the 95th percentile of the errors (at least 0.05 mm).
+    std::vector<double> sorted = err;
+    std::sort(sorted.begin(), sorted.end());
+    const double top = std::max(0.05, sorted.empty() ? 0.0 : sorted[sorted.size() * 95 / 100]);
+    views.push_back(taxel_demo::view_html(
+        "view-" + o.name,
+        o.name + ": the Surfel-fused cloud (" + std::to_string(kalman.size()) +
+            " points), coloured by its distance to the true surface; drag to turn, wheel to "
+            "zoom (<a href=\"" +
+            o.name + "_kalman.svg\">as SVG</a>)",
+        {taxel_demo::ramp_layer(kalman.points, err, top)}, top, "mm and above"));
   }
   page.heading("1. Contact fusion: raw, averaging, Kalman and Surfel");
   page.para(
@@ -255,11 +340,7 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
   page.table({"object", "policy", "contacts", "points", "compaction", "mean mm", "RMS mm", "max mm",
               "coverage", "signed mm"},
              rows);
-  for (const Object& o : objects) {
-    page.figure(o.name + "_kalman.svg", o.name +
-                                            ": the Surfel-fused cloud, coloured by its "
-                                            "distance to the true surface");
-  }
+  for (const std::string& v : views) page.raw(v);
   // Error against contacts, for the first object.
   const auto contacts = objects[1].explore(Isometry3d::Identity(), quick, 101);
   io::LinePlot plot;
@@ -277,7 +358,7 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
   }
   io::write_file((out / "error_vs_contacts.svg").string(), io::render_svg(plot));
   page.figure("error_vs_contacts.svg", "RMS error of the four policies as contacts accumulate");
-  page.links(files);
+  page.links(files, out);
 }
 
 // ---- 2. recognition ------------------------------------------------------------------------
@@ -292,6 +373,8 @@ void recognition_section(const std::vector<Object>& objects, bool quick, Page& p
   std::normal_distribution<double> g(0.0, 1.0);
   double seconds = 0.0;
   int right = 0;
+  std::vector<std::vector<std::string>> pose_rows;
+  std::vector<std::string> views;
   for (int t = 0; t < trials; ++t) {
     for (std::size_t o = 0; o < n; ++o) {
       Isometry3d pose = Isometry3d::Identity();
@@ -311,6 +394,32 @@ void recognition_section(const std::vector<Object>& objects, bool quick, Page& p
         answer = objects[k].name == r.best ? k : answer;
       ++confusion[o][answer];
       right += answer == o ? 1 : 0;
+      // The pose: T_model_cloud maps the cloud (in the world) onto the model, so composed with
+      // the object's true pose it is a symmetry of the object when right.
+      const tr::ModelMatch& top = r.ranking.front();
+      if (top.name == objects[o].name) {
+        const Isometry3d err = top.transform * pose;
+        const double centre_mm = 1e3 * err.translation().norm();
+        const double rot = rotation_error_deg(err.linear(), objects[o].symmetry);
+        pose_rows.push_back({objects[o].name, std::to_string(t + 1), r.unknown ? "unknown" : r.best,
+                             fmt("%.2f", 1e3 * top.score), fmt("%.2f", centre_mm),
+                             std::isnan(rot) ? "any (sphere)" : fmt("%.2f", rot)});
+      } else {
+        pose_rows.push_back({objects[o].name, std::to_string(t + 1), r.unknown ? "unknown" : r.best,
+                             fmt("%.2f", 1e3 * top.score), "-", "-"});
+      }
+      if (t == 0) {  // the cloud on the model it was recognised as
+        std::size_t shown = o;
+        for (std::size_t k = 0; k < n; ++k) shown = objects[k].name == top.name ? k : shown;
+        const PointCloud<double> aligned = transformed(cloud.to_point_cloud(), top.transform);
+        views.push_back(taxel_demo::view_html(
+            "recognised-" + objects[o].name,
+            objects[o].name + " at a random pose, recognised as " + top.name +
+                ": its fused cloud (red) mapped by the recognised pose onto the model (grey)",
+            {taxel_demo::plain_layer(objects[shown].model(8000).points, {150, 150, 150}, 4000,
+                                     2.0f),
+             taxel_demo::plain_layer(aligned.points, {220, 40, 30}, 100000, 4.0f)}));
+      }
     }
   }
   const int total = trials * int(n);
@@ -341,6 +450,14 @@ void recognition_section(const std::vector<Object>& objects, bool quick, Page& p
       std::to_string(right) + " / " + std::to_string(total) + ", " +
       fmt("%.1f", 1e3 * seconds / total) + " ms per recognition.");
   page.table(head, rows);
+  page.para(
+      "The recognised poses against the true ones: where the object's origin lands (centre "
+      "error) and the rotation error, up to the object's symmetries (any turn of a sphere, "
+      "turns of a cylinder or cone about its axis, half turns of a box, the 24 turns of a "
+      "cube).");
+  page.table({"object", "trial", "answer", "score mm", "centre error mm", "rotation error deg"},
+             pose_rows);
+  for (const std::string& v : views) page.raw(v);
 }
 
 // ---- 3. pressure images ----------------------------------------------------------------------
@@ -370,11 +487,11 @@ void image_section(bool quick, const fs::path& out, Page& page) {
       shown[label] = true;
       const ti::Segmentation& seg = rec.segmentation();
       ti::Image<std::uint8_t> hpr = seg.high;
-      rows.push_back(
-          io::side_by_side({io::colorize(data[i].image, 0, 255), io::colorize_classes(seg.classes),
-                            io::colorize_classes(hpr * std::uint8_t{2}),
-                            io::colorize(rec.reconstruction(), 0,
-                                         std::max(1e-9, rec.reconstruction().maxCoeff()))}));
+      rows.push_back(io::side_by_side(
+          {io::colorize(data[i].image, 0, 255, 6), io::colorize_classes(seg.classes, 6),
+           io::colorize_classes(hpr * std::uint8_t{2}, 6),
+           io::colorize(rec.reconstruction(), 0, std::max(1e-9, rec.reconstruction().maxCoeff()),
+                        6)}));
     }
   }
   const std::string picture = write_picture(out, "pressure_images", io::stacked(rows));
@@ -403,9 +520,15 @@ void image_section(bool quick, const fs::path& out, Page& page) {
   page.table({"features", "accuracy"},
              {{"conventional: 11 region descriptors", fmt("%.1f %%", a_conv)},
               {"hybrid: reconstruction gradients + descriptors", fmt("%.1f %%", a_hyb)}});
+  page.raw(
+      "<div class=\"labels\"><span>pressure (0-255)</span><span>k-means: background (black), "
+      "low (grey), high (white)</span><span>high-pressure regions (white)</span><span>3-D "
+      "reconstruction: height (RecEdged / RecEdgeless)</span></div>\n");
   page.figure(picture,
-              "one image per class (rows: planar, one-edged, two-edged, cylindrical): "
-              "pressure | background/low/high | high-pressure regions | reconstruction");
+              "one image per class, rows top to bottom: planar, one-edged, two-edged, "
+              "cylindrical; 32 x 32 tactels, 6 pixels each");
+  page.raw(colour_bar("pressure reading", "0", "255") +
+           colour_bar("reconstructed height, per image", "0", "its maximum"));
 }
 
 // ---- 4. a recorded session --------------------------------------------------------------------
@@ -456,15 +579,37 @@ void session_section(const fs::path& out, Page& page) {
       std::to_string(total) + " contacts fused into " + std::to_string(cloud.size()) + " points.");
   if (busiest_contacts > 0) {
     page.figure(write_picture(out, "session_frame", busiest),
-                "the frame with the most contact: the six 14x6 matrices, readings 0-4095");
+                "the frame with the most contact: the six 14x6 matrices (0 to 5, left to "
+                "right; rows top to bottom), readings 0-4095");
+    page.raw(colour_bar("reading", "0", "4095"));
   }
-  page.links({"session_cloud.ply"});
+  page.links({"session_cloud.ply"}, out);
 #else
   (void)out;
   std::printf("\n4. (drivers not built: no session replay; build with libusb-1.0-0-dev)\n");
   page.heading("4. A recorded DSACON32m session");
   page.para("Not run: taxel was built without its drivers (they need libusb-1.0-0-dev).");
 #endif
+}
+
+std::string compiler() {
+#if defined(__clang__)
+  return "clang " __clang_version__;
+#elif defined(__GNUC__)
+  return "g++ " __VERSION__;
+#else
+  return "an unknown compiler";
+#endif
+}
+
+// The time of the run, UTC, as 2026-01-31 12:00 UTC.
+std::string run_time() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", &utc);
+  return buf;
 }
 
 }  // namespace
@@ -495,12 +640,12 @@ int main(int argc, char** argv) try {
   const auto t0 = Clock::now();
   std::printf("taxel-demo%s: output in %s\n", quick ? " (quick)" : "", out.c_str());
   const std::vector<Object> objects{
-      make_object("sphere-40", sim::Sphere(0.04)),
-      make_object("cylinder-30x100", sim::Cylinder(0.03, 0.05)),
-      make_object("box-80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02))),
-      make_object("cone-30x60", sim::Cone(0.03, 0.06)),
-      make_object("cube-50", sim::Box(Vec3d(0.025, 0.025, 0.025))),
-      make_object("sphere-25", sim::Sphere(0.025)),
+      make_object("sphere-40", sim::Sphere(0.04), Symmetry::sphere),
+      make_object("cylinder-30x100", sim::Cylinder(0.03, 0.05), Symmetry::cylinder),
+      make_object("box-80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02)), Symmetry::box),
+      make_object("cone-30x60", sim::Cone(0.03, 0.06), Symmetry::cone),
+      make_object("cube-50", sim::Box(Vec3d(0.025, 0.025, 0.025)), Symmetry::cube),
+      make_object("sphere-25", sim::Sphere(0.025), Symmetry::sphere),
   };
   Page page;
   const std::vector<Object> fused(objects.begin(), objects.begin() + 4);
@@ -512,10 +657,14 @@ int main(int argc, char** argv) try {
   io::write_file(
       (out / "index.html").string(),
       page.html("Everything below was computed by <code>taxel-demo" +
-                std::string(quick ? " --quick" : "") + "</code> in " + fmt("%.0f", seconds) +
-                " s on simulated data; each section names the "
-                "headers it uses. Clouds are PLY files (open them in MeshLab or "
-                "CloudCompare); the pictures are SVG and PNG."));
+                    std::string(quick ? " --quick" : "") + "</code> in " + fmt("%.0f", seconds) +
+                    " s on simulated data; each section names the headers it uses. The 3-D "
+                    "views turn when dragged (axes in millimetres); the clouds are also PLY "
+                    "files, the pictures SVG and PNG.",
+                "taxel " TAXEL_VERSION_STRING " &middot; taxel-demo" +
+                    std::string(quick ? " --quick" : "") +
+                    ", built " __DATE__ " " __TIME__ " with " + compiler() + " &middot; run " +
+                    run_time() + " in " + fmt("%.0f", seconds) + " s"));
   std::printf("\ndone in %.0f s; open %s\n", seconds, (out / "index.html").c_str());
   return 0;
 } catch (const std::exception& e) {
