@@ -34,6 +34,7 @@
 
 #include "cli.hpp"
 #include "demo_viewer.hpp"
+#include "report.hpp"
 
 namespace {
 
@@ -45,6 +46,11 @@ namespace tl = taxel::learn;
 namespace tr = taxel::registration;
 
 using Clock = std::chrono::steady_clock;
+
+// Progress and tables: standard output, or standard error when --format asks for JSON or CSV
+// there; the figures also go into `figures`.
+FILE* say = stdout;
+taxel_cli::Json figures = taxel_cli::Json::object();
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -285,11 +291,12 @@ Object make_object(std::string name, Shape shape, Symmetry symmetry) {
 
 void fusion_section(const std::vector<Object>& objects, bool quick, const fs::path& out,
                     Page& page) {
-  std::printf(
+  std::fprintf(
+      say,
       "\n1. Contact fusion: a three-finger hand (two 14x6 DSA-like pads per finger, 3.4 mm "
       "tactels, 12-bit readings) grasps, palpates and slides over each object\n");
-  std::printf("%-16s %-8s %8s %7s %8s %8s %8s %7s %8s %10s\n", "object", "policy", "contacts",
-              "points", "compact", "mean mm", "rms mm", "max mm", "cover", "signed mm");
+  std::fprintf(say, "%-16s %-8s %8s %7s %8s %8s %8s %7s %8s %10s\n", "object", "policy", "contacts",
+               "points", "compact", "mean mm", "rms mm", "max mm", "cover", "signed mm");
   std::vector<std::vector<std::string>> rows;
   std::vector<std::string> files, views;
   for (std::size_t i = 0; i < objects.size(); ++i) {
@@ -297,10 +304,19 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
     const auto contacts = o.explore(Isometry3d::Identity(), quick, 100 + i);
     PointCloud<double> kalman;
     for (const FusionRow& r : o.fuse_all(contacts, out, kalman)) {
-      std::printf("%-16s %-8s %8zu %7zu %7.1fx %8.3f %8.3f %8.2f %6.1f%% %+10.3f\n",
-                  r.object.c_str(), r.policy.c_str(), r.m.contacts, r.m.points, r.m.compaction,
-                  1e3 * r.m.error.mean, 1e3 * r.m.error.rms, 1e3 * r.m.error.max,
-                  100.0 * r.m.coverage, 1e3 * r.m.error.signed_mean);
+      std::fprintf(say, "%-16s %-8s %8zu %7zu %7.1fx %8.3f %8.3f %8.2f %6.1f%% %+10.3f\n",
+                   r.object.c_str(), r.policy.c_str(), r.m.contacts, r.m.points, r.m.compaction,
+                   1e3 * r.m.error.mean, 1e3 * r.m.error.rms, 1e3 * r.m.error.max,
+                   100.0 * r.m.coverage, 1e3 * r.m.error.signed_mean);
+      figures["fusion"].push_back({{"object", r.object},
+                                   {"policy", r.policy},
+                                   {"contacts", r.m.contacts},
+                                   {"points", r.m.points},
+                                   {"mean_mm", 1e3 * r.m.error.mean},
+                                   {"rms_mm", 1e3 * r.m.error.rms},
+                                   {"max_mm", 1e3 * r.m.error.max},
+                                   {"signed_mm", 1e3 * r.m.error.signed_mean},
+                                   {"coverage", r.m.coverage}});
       rows.push_back({r.object, r.policy, std::to_string(r.m.contacts), std::to_string(r.m.points),
                       fmt("%.1fx", r.m.compaction), fmt("%.3f", 1e3 * r.m.error.mean),
                       fmt("%.3f", 1e3 * r.m.error.rms), fmt("%.2f", 1e3 * r.m.error.max),
@@ -423,23 +439,27 @@ void recognition_section(const std::vector<Object>& objects, bool quick, Page& p
     }
   }
   const int total = trials * int(n);
-  std::printf("\n2. Recognition by ICP among %zu models, %d trial(s) per object at random poses\n",
-              n, trials);
+  std::fprintf(say,
+               "\n2. Recognition by ICP among %zu models, %d trial(s) per object at random poses\n",
+               n, trials);
   std::vector<std::string> head{"true \\ answer"};
   for (const auto& o : objects) head.push_back(o.name);
   head.push_back("unknown");
   std::vector<std::vector<std::string>> rows;
   for (std::size_t o = 0; o < n; ++o) {
-    std::printf("%-16s", objects[o].name.c_str());
+    std::fprintf(say, "%-16s", objects[o].name.c_str());
     std::vector<std::string> row{objects[o].name};
     for (std::size_t k = 0; k <= n; ++k) {
-      std::printf(" %3d", confusion[o][k]);
+      std::fprintf(say, " %3d", confusion[o][k]);
       row.push_back(std::to_string(confusion[o][k]));
     }
-    std::printf("\n");
+    std::fprintf(say, "\n");
     rows.push_back(row);
   }
-  std::printf("top-1 %d / %d, %.1f ms per recognition\n", right, total, 1e3 * seconds / total);
+  std::fprintf(say, "top-1 %d / %d, %.1f ms per recognition\n", right, total,
+               1e3 * seconds / total);
+  figures["recognition"] = {
+      {"right", right}, {"total", total}, {"ms_per_cloud", 1e3 * seconds / total}};
   page.heading("2. Recognising objects by touch (ICP)");
   page.para(
       "Each object is explored by the hand at a random pose, its contacts fused by Kalman "
@@ -505,11 +525,13 @@ void image_section(bool quick, const fs::path& out, Page& page) {
     return 100.0 * r.accuracy;
   };
   const double a_conv = cv(conv), a_hyb = cv(hyb);
-  std::printf(
-      "\n3. Pressure images: %zu synthetic 32x32 palm grasps, 4 classes; linear SVM, "
-      "5-fold CV\n   conventional (11 region descriptors) %.1f %%, hybrid (reconstruction "
-      "gradients + descriptors) %.1f %%\n",
-      data.size(), a_conv, a_hyb);
+  std::fprintf(say,
+               "\n3. Pressure images: %zu synthetic 32x32 palm grasps, 4 classes; linear SVM, "
+               "5-fold CV\n   conventional (11 region descriptors) %.1f %%, hybrid (reconstruction "
+               "gradients + descriptors) %.1f %%\n",
+               data.size(), a_conv, a_hyb);
+  figures["images"] = {
+      {"images", data.size()}, {"conventional", a_conv / 100}, {"hybrid", a_hyb / 100}};
   page.heading("3. Pressure images: segmentation, reconstruction, recognition");
   page.para(
       "Synthetic 32x32 palm-grasp images of planar, one-edged, two-edged and cylindrical "
@@ -566,10 +588,14 @@ void session_section(const fs::path& out, Page& page) {
   const auto stats = dev.stats();
   dev.close();
   io::write_ply((out / "session_cloud.ply").string(), cloud.to_point_cloud());
-  std::printf(
-      "\n4. Recorded DSACON32m session replayed through the driver: %zu frames (%llu "
-      "dropped), %zu contacts fused into %zu points\n",
-      frames, static_cast<unsigned long long>(stats.dropped_frames), total, cloud.size());
+  std::fprintf(say,
+               "\n4. Recorded DSACON32m session replayed through the driver: %zu frames (%llu "
+               "dropped), %zu contacts fused into %zu points\n",
+               frames, static_cast<unsigned long long>(stats.dropped_frames), total, cloud.size());
+  figures["session"] = {{"frames", frames},
+                        {"dropped", stats.dropped_frames},
+                        {"contacts", total},
+                        {"points", cloud.size()}};
   page.heading("4. A recorded DSACON32m session through the driver");
   page.para(
       "data/sessions/cylinder_grasp.session: a simulated grasp of a cylinder streamed by the "
@@ -586,7 +612,7 @@ void session_section(const fs::path& out, Page& page) {
   page.links({"session_cloud.ply"}, out);
 #else
   (void)out;
-  std::printf("\n4. (drivers not built: no session replay; build with libusb-1.0-0-dev)\n");
+  std::fprintf(say, "\n4. (drivers not built: no session replay; build with libusb-1.0-0-dev)\n");
   page.heading("4. A recorded DSACON32m session");
   page.para("Not run: taxel was built without its drivers (they need libusb-1.0-0-dev).");
 #endif
@@ -618,16 +644,29 @@ int main(int argc, char** argv) try {
   taxel_cli::check_stdout_at_exit("taxel-demo");
   taxel_cli::print_version_if_asked("taxel-demo", argc, argv);
   bool quick = false;
+  taxel_cli::Format format = taxel_cli::Format::text;
   fs::path out = "taxel-demo-output";
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (a == "--quick") {
       quick = true;
+    } else if (a == "--format" || a.starts_with("--format=")) {
+      const std::string_view v =
+          a.size() > 8 ? a.substr(9) : (i + 1 < argc ? std::string_view(argv[++i]) : "");
+      if (v != "text" && v != "json" && v != "csv") {
+        std::fprintf(stderr, "taxel-demo: --format must be one of text,json,csv, not '%s'\n",
+                     std::string(v).c_str());
+        return 2;
+      }
+      format = taxel_cli::to_format(v);
+      say = format == taxel_cli::Format::text ? stdout : stderr;
     } else if (a == "-h" || a == "--help") {
       std::puts(
-          "usage: taxel-demo [--quick] [--version] [OUTPUT-FOLDER]\n"
+          "usage: taxel-demo [--quick] [--format text|json|csv] [--version] [OUTPUT-FOLDER]\n"
           "Runs taxel end to end on simulated data and writes tables, PLY clouds,\n"
-          "pictures and an index.html into OUTPUT-FOLDER (default taxel-demo-output).");
+          "pictures and an index.html into OUTPUT-FOLDER (default taxel-demo-output).\n"
+          "--format json prints the figures as one JSON document on standard output (csv: the\n"
+          "fusion table), the progress going to standard error.");
       return 0;
     } else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "taxel-demo: unknown option '%s' (see --help)\n", argv[i]);
@@ -638,7 +677,7 @@ int main(int argc, char** argv) try {
   }
   fs::create_directories(out);
   const auto t0 = Clock::now();
-  std::printf("taxel-demo%s: output in %s\n", quick ? " (quick)" : "", out.c_str());
+  std::fprintf(say, "taxel-demo%s: output in %s\n", quick ? " (quick)" : "", out.c_str());
   const std::vector<Object> objects{
       make_object("sphere-40", sim::Sphere(0.04), Symmetry::sphere),
       make_object("cylinder-30x100", sim::Cylinder(0.03, 0.05), Symmetry::cylinder),
@@ -665,7 +704,15 @@ int main(int argc, char** argv) try {
                     std::string(quick ? " --quick" : "") +
                     ", built " __DATE__ " " __TIME__ " with " + compiler() + " &middot; run " +
                     run_time() + " in " + fmt("%.0f", seconds) + " s"));
-  std::printf("\ndone in %.0f s; open %s\n", seconds, (out / "index.html").c_str());
+  std::fprintf(say, "\ndone in %.0f s; open %s\n", seconds, (out / "index.html").c_str());
+  if (format != taxel_cli::Format::text) {
+    figures["version"] = TAXEL_VERSION_STRING;
+    figures["seconds"] = seconds;
+    figures["page"] = (out / "index.html").string();
+    const std::string text =
+        taxel_cli::render(format == taxel_cli::Format::json ? figures : figures["fusion"], format);
+    std::fwrite(text.data(), 1, text.size(), stdout);
+  }
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "taxel-demo: %s\n", e.what());

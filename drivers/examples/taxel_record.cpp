@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "../../examples/cli.hpp"
+#include "../../examples/report.hpp"
 #include "device_cli.hpp"
 
 namespace {
@@ -42,6 +43,7 @@ options:
   --grasps G         with --emulate: grasps to simulate (default 8)
   --period-ms P      with --emulate: frame period (default 33.3, about 30 frames/s)
   --seed S           with --emulate (default 1)
+  --format text|json|csv  how the summary is printed (default text)
   -h, --help         show this help
   --version          show taxel's version
 
@@ -56,7 +58,11 @@ struct Options {
   double period_ms = 1000.0 / 30.0;
   long timeout_ms = 1000;
   std::uint64_t seed = 1;
+  taxel_cli::Format format = taxel_cli::Format::text;
 };
+
+// The summary, printed once at the end.
+taxel_cli::Json summary = taxel_cli::Json::object();
 
 template <class T>
 int record(T transport, const Options& o, const taxel_cli::Args& args) {
@@ -83,12 +89,15 @@ int record(T transport, const Options& o, const taxel_cli::Args& args) {
   const auto s = dev.stats();
   std::size_t bytes = 0;
   for (const auto& c : dev.transport().chunks()) bytes += c.bytes.size();
-  std::printf("controller sw %u serial %u\nmatrices %zu\ntactels %zu\nframes %d\n",
-              unsigned(dev.controller_info().sw_version), unsigned(dev.controller_info().serial_no),
-              dev.matrices().size(), dev.cells(), got);
-  std::printf("dropped %llu\ncrc errors %zu\nbytes %zu\nwrote %s\n",
-              static_cast<unsigned long long>(s.dropped_frames), s.link.crc_errors, bytes,
-              o.out.c_str());
+  summary["controller_sw"] = unsigned(dev.controller_info().sw_version);
+  summary["controller_serial"] = unsigned(dev.controller_info().serial_no);
+  summary["matrices"] = dev.matrices().size();
+  summary["tactels"] = dev.cells();
+  summary["frames"] = got;
+  summary["dropped"] = s.dropped_frames;
+  summary["crc_errors"] = s.link.crc_errors;
+  summary["bytes"] = bytes;
+  summary["session"] = o.out;
   return 0;
 }
 
@@ -124,7 +133,7 @@ int emulate(const Shape& shape, const Options& o, const taxel_cli::Args& args) {
     } catch (const std::exception& e) {
       args.fail(e.what(), 1);
     }
-    std::printf("wrote %s\n", o.poses.c_str());
+    summary["poses"] = o.poses;
   }
   return rc;
 }
@@ -165,6 +174,8 @@ int main(int argc, char** argv) {
       o.period_ms = args.number<double>(1.0, 10000.0);
     } else if (a == "--seed") {
       o.seed = args.number<std::uint64_t>(0, std::numeric_limits<std::uint64_t>::max());
+    } else if (a == "--format") {
+      o.format = taxel_cli::to_format(args.choice("text|json|csv"));
     } else if (a.size() > 1 && a[0] == '-') {
       args.fail("unknown option '" + std::string(a) + "' (see --help)");
     } else if (o.out.empty()) {
@@ -184,23 +195,28 @@ int main(int argc, char** argv) {
     return *p;
   };
   if (o.frames < 0 && o.emulate.empty()) o.frames = 100;
+  const auto done = [&](int rc) {
+    const std::string text = taxel_cli::render(summary, o.format);
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return rc;
+  };
   try {
-    if (!o.serial.empty()) return record(td::SerialTransport(o.serial, o.baud), o, args);
+    if (!o.serial.empty()) return done(record(td::SerialTransport(o.serial, o.baud), o, args));
     if (!o.usb.empty()) {
       const auto [vid, pid] = pair(o.usb, 16, "--usb");
-      return record(
+      return done(record(
           td::UsbTransport({.vendor_id = std::uint16_t(vid), .product_id = std::uint16_t(pid)}), o,
-          args);
+          args));
     }
     if (!o.usb_bus.empty()) {
       const auto [bus, addr] = pair(o.usb_bus, 10, "--usb-bus");
       if (bus > 255 || addr > 255) args.fail("--usb-bus: bus and address are at most 255");
-      return record(td::UsbTransport({.bus = std::uint8_t(bus), .address = std::uint8_t(addr)}), o,
-                    args);
+      return done(record(
+          td::UsbTransport({.bus = std::uint8_t(bus), .address = std::uint8_t(addr)}), o, args));
     }
-    if (o.emulate == "sphere") return emulate(taxel::sim::Sphere(0.04), o, args);
-    if (o.emulate == "cylinder") return emulate(taxel::sim::Cylinder(0.03, 0.05), o, args);
-    return emulate(taxel::sim::Box(taxel::Vec3d(0.04, 0.03, 0.02)), o, args);
+    if (o.emulate == "sphere") return done(emulate(taxel::sim::Sphere(0.04), o, args));
+    if (o.emulate == "cylinder") return done(emulate(taxel::sim::Cylinder(0.03, 0.05), o, args));
+    return done(emulate(taxel::sim::Box(taxel::Vec3d(0.04, 0.03, 0.02)), o, args));
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }

@@ -74,3 +74,23 @@ endif()
 if(HAVE_DRIVERS)
   expect("${out}" "replayed through the driver: 78 frames \\(0 dropped\\), [1-9][0-9]* contacts fused")
 endif()
+
+# --format json: the figures as one JSON document on standard output, progress on standard
+# error; --version.
+execute_process(COMMAND "${DEMO}" --quick --format=json "${WORK_DIR}/json"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE json ERROR_VARIABLE progress)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "taxel-demo --format json: exit ${rc}\n${progress}")
+endif()
+string(JSON right ERROR_VARIABLE json_error GET "${json}" recognition right)
+string(JSON policy ERROR_VARIABLE json_error2 GET "${json}" fusion 3 policy)
+if(json_error OR json_error2 OR NOT right GREATER 0 OR NOT policy STREQUAL "surfel")
+  message(FATAL_ERROR "taxel-demo --format json: ${json_error} ${json_error2}\n${json}")
+endif()
+if(NOT progress MATCHES "1. Contact fusion")
+  message(FATAL_ERROR "taxel-demo --format json: no progress on standard error")
+endif()
+execute_process(COMMAND "${DEMO}" --version RESULT_VARIABLE rc OUTPUT_VARIABLE v)
+if(NOT rc EQUAL 0 OR NOT v MATCHES "^taxel-demo \\(taxel\\) [0-9]+\\.[0-9]+\\.[0-9]+\n$")
+  message(FATAL_ERROR "taxel-demo --version: ${v}")
+endif()
