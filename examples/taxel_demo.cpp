@@ -646,19 +646,14 @@ int main(int argc, char** argv) try {
   bool quick = false;
   taxel_cli::Format format = taxel_cli::Format::text;
   fs::path out = "taxel-demo-output";
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
+  taxel_cli::Args args("taxel-demo", argc, argv);
+  std::string_view a;
+  bool have_out = false;
+  while (args.next(a)) {
     if (a == "--quick") {
       quick = true;
-    } else if (a == "--format" || a.starts_with("--format=")) {
-      const std::string_view v =
-          a.size() > 8 ? a.substr(9) : (i + 1 < argc ? std::string_view(argv[++i]) : "");
-      if (v != "text" && v != "json" && v != "csv") {
-        std::fprintf(stderr, "taxel-demo: --format must be one of text,json,csv, not '%s'\n",
-                     std::string(v).c_str());
-        return 2;
-      }
-      format = taxel_cli::to_format(v);
+    } else if (a == "--format") {
+      format = taxel_cli::to_format(args.choice("text|json|csv"));
       say = format == taxel_cli::Format::text ? stdout : stderr;
     } else if (a == "-h" || a == "--help") {
       std::puts(
@@ -668,11 +663,13 @@ int main(int argc, char** argv) try {
           "--format json prints the figures as one JSON document on standard output (csv: the\n"
           "fusion table), the progress going to standard error.");
       return 0;
-    } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "taxel-demo: unknown option '%s' (see --help)\n", argv[i]);
-      return 2;
+    } else if (a.size() > 1 && a[0] == '-') {
+      args.fail("unknown option '" + std::string(a) + "' (see --help)");
+    } else if (!have_out) {
+      out = std::string(a);
+      have_out = true;
     } else {
-      out = argv[i];
+      args.fail("expected one OUTPUT-FOLDER, got a second: '" + std::string(a) + "'");
     }
   }
   fs::create_directories(out);

@@ -27,7 +27,8 @@ constexpr const char* kUsage = R"usage(usage: taxel-record [options] SESSION.txt
 
 Opens a DSACON32m tactile controller, streams frames and records the whole conversation (every
 byte both ways, time-stamped) to SESSION.txt, which ReplayTransport and 07_stream_fusion play
-back without hardware.
+back without hardware. SESSION.txt may be `-` (standard output; the summary then goes to
+standard error).
 
 source (one):
   --serial DEVICE    a serial port, e.g. /dev/ttyUSB0 (115200 baud unless --baud)
@@ -82,7 +83,7 @@ int record(T transport, const Options& o, const taxel_cli::Args& args) {
     }
     dev.stop();
     dev.close();
-    td::write_session(o.out, dev.transport().chunks());
+    taxel_cli::write_output(o.out, td::format_session(dev.transport().chunks()));
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }
@@ -97,7 +98,7 @@ int record(T transport, const Options& o, const taxel_cli::Args& args) {
   summary["dropped"] = s.dropped_frames;
   summary["crc_errors"] = s.link.crc_errors;
   summary["bytes"] = bytes;
-  summary["session"] = o.out;
+  summary["session"] = o.out == "-" ? std::string("<stdout>") : o.out;
   return 0;
 }
 
@@ -197,7 +198,7 @@ int main(int argc, char** argv) {
   if (o.frames < 0 && o.emulate.empty()) o.frames = 100;
   const auto done = [&](int rc) {
     const std::string text = taxel_cli::render(summary, o.format);
-    std::fwrite(text.data(), 1, text.size(), stdout);
+    std::fwrite(text.data(), 1, text.size(), o.out == "-" ? stderr : stdout);
     return rc;
   };
   try {

@@ -94,3 +94,11 @@ execute_process(COMMAND "${DEMO}" --version RESULT_VARIABLE rc OUTPUT_VARIABLE v
 if(NOT rc EQUAL 0 OR NOT v MATCHES "^taxel-demo \\(taxel\\) [0-9]+\\.[0-9]+\\.[0-9]+\n$")
   message(FATAL_ERROR "taxel-demo --version: ${v}")
 endif()
+# Bad options: exit 2 with a one-line reason, nothing run.
+foreach(bad "--format=yaml" "--quick=yes" "--frobnicate")
+  execute_process(COMMAND "${DEMO}" ${bad} "${WORK_DIR}/bad" RESULT_VARIABLE rc
+                  OUTPUT_VARIABLE o ERROR_VARIABLE e)
+  if(NOT rc EQUAL 2 OR NOT e MATCHES "^taxel-demo: [^\n]+\n$" OR EXISTS "${WORK_DIR}/bad")
+    message(FATAL_ERROR "taxel-demo ${bad}: exit ${rc}, expected 2 and one line\n${e}")
+  endif()
+endforeach()
