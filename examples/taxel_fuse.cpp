@@ -60,6 +60,8 @@ options:
   --process-noise Q surfel, kalman: process noise [m] per update (default 0)
   --min-observations N   keep only points with at least N contacts (default 1: all)
   --max-sigma S     keep only points whose largest standard deviation is at most S [m]
+  --max-normal-sigma S  keep only points whose smallest standard deviation (across the
+                    surface) is at most S [m]: 0.3mm drops points only a coarse pad has seen
   --ascii           write ASCII PLY (default binary little-endian)
   --strict          refuse a CONTACTS.csv with any bad row or unknown column (default: skip
                     bad rows, counted as "skipped_rows" with the first one's reason on
@@ -67,7 +69,8 @@ options:
   --scale F         multiply the contacts' positions by F (covariances by F^2): --scale 0.001
                     for a CSV in millimetres (CONTACTS.csv only)
 readings (--readings, --session):
-  --per-pad         one contact per pad and frame (default: one per active tactel)
+  --per-pad         one contact per pad and frame (default: one per active tactel; a frame
+                    with under six active tactels gives one per tactel)
   --pitch P         tactel pitch [m] (default 0.0034; --readings only)
   --levels L        reading levels, e.g. 4096 for 12 bits (default 4096; --readings only)
   --full-scale-depth D   indentation at the largest reading [m] (default 0.003)
@@ -104,6 +107,7 @@ struct Options {
   double frame_rate = 1000.0;
   taxel::sensor::SensorModel model;
   double max_sigma = std::numeric_limits<double>::infinity();
+  double max_normal_sigma = std::numeric_limits<double>::infinity();
   double scale = 1.0;
   taxel_cli::Format format = taxel_cli::Format::text;
   std::vector<std::string> files;
@@ -172,7 +176,7 @@ int fuse(const Options& o, typename Cloud::Config cfg,
                  "0.001)?\n",
                  o.radius);
   }
-  const auto kept = cloud.to_point_cloud({o.min_observations, o.max_sigma});
+  const auto kept = cloud.to_point_cloud({o.min_observations, o.max_sigma, o.max_normal_sigma});
   summary["written"] = kept.size();
   try {
     taxel_cli::write_output(
@@ -291,6 +295,8 @@ int main(int argc, char** argv) {
       o.min_observations = args.number<std::uint32_t>(1, 4294967295u);
     } else if (a == "--max-sigma") {
       o.max_sigma = args.length(0.0, kInf);
+    } else if (a == "--max-normal-sigma") {
+      o.max_normal_sigma = args.length(0.0, kInf);
     } else if (a == "--strict") {
       o.strict = true;
     } else if (a == "--ascii") {

@@ -50,7 +50,8 @@ options:
   --exploration sliding|grasp|palpation   (default sliding)
   --contacts N       stop after N contacts, exploring further as needed (default 20000;
                      0: exactly the exploration below)
-  --per-pad          one pressure-weighted contact per pad and frame, not one per tactel
+  --per-pad          one contact per pad and frame (a quadric fitted to its depth map; one per
+                     tactel when under six are active), not one per tactel
   --slides K         sliding: slides from random starts (default 4)
   --frames F         sliding: frames per slide (default 1000)
   --speed V          sliding speed [m/s] (default 0.05)

@@ -229,6 +229,16 @@ if(NOT CMAKE_MATCH_1 LESS all_points OR CMAKE_MATCH_1 EQUAL 0)
 endif()
 run_tool("${TOOL}" 2 --max-sigma -1 torus.csv x.ply)
 expect("${err}" "--max-sigma")
+# Across the surface: a tight bound keeps some points and drops some.
+run_tool("${TOOL}" 0 --readings grasp.npy --poses grasp_poses.csv --max-normal-sigma=0.05mm
+         --format json across.ply)
+json_get(all_points "${out}" points)
+json_get(kept "${out}" written)
+if(NOT kept LESS all_points OR kept EQUAL 0)
+  message(FATAL_ERROR "--max-normal-sigma=0.05mm kept ${kept} of ${all_points} points")
+endif()
+run_tool("${TOOL}" 2 --max-normal-sigma -1mm torus.csv x.ply)
+expect("${err}" "--max-normal-sigma")
 # Bad readings input: each refused with the file and the reason, exit 1, no output.
 run_tool("${TOOL}" 2 --readings grasp.npy x.ply)
 expect("${err}" "--readings needs --poses")

@@ -49,8 +49,10 @@ class CloudBase {
   virtual void covariances(double* out) const = 0;
   virtual void observations(std::uint32_t* out) const = 0;
   virtual void last_times(double* out) const = 0;
-  virtual bool confident(std::size_t id, std::uint32_t min_obs, double max_sigma) const = 0;
-  virtual Cloud to_point_cloud(std::uint32_t min_obs, double max_sigma) const = 0;
+  virtual bool confident(std::size_t id, std::uint32_t min_obs, double max_sigma,
+                         double max_normal_sigma) const = 0;
+  virtual Cloud to_point_cloud(std::uint32_t min_obs, double max_sigma,
+                               double max_normal_sigma) const = 0;
 };
 
 template <class F, class I>
@@ -90,11 +92,14 @@ class CloudImpl final : public CloudBase {
       out[i] = cloud_.last_time(static_cast<index::PointId>(i));
     }
   }
-  bool confident(std::size_t id, std::uint32_t min_obs, double max_sigma) const override {
-    return cloud_.confident(static_cast<index::PointId>(id), {min_obs, max_sigma});
+  bool confident(std::size_t id, std::uint32_t min_obs, double max_sigma,
+                 double max_normal_sigma) const override {
+    return cloud_.confident(static_cast<index::PointId>(id),
+                            {min_obs, max_sigma, max_normal_sigma});
   }
-  Cloud to_point_cloud(std::uint32_t min_obs, double max_sigma) const override {
-    return cloud_.to_point_cloud({min_obs, max_sigma});
+  Cloud to_point_cloud(std::uint32_t min_obs, double max_sigma,
+                       double max_normal_sigma) const override {
+    return cloud_.to_point_cloud({min_obs, max_sigma, max_normal_sigma});
   }
 
  private:
@@ -310,8 +315,9 @@ sigma_tilt [rad] are the per-frame noise of the pad pose. Defaults: a Weiss DSA 
       });
 
   py::class_<sensor::ContactOptions>(s, "ContactOptions", R"doc(
-How readings become contacts: `mode` 'per_tactel' (a contact per active tactel) or 'per_pad';
-`local_normals` (normals from the pad's depth map, else the pad normal); `correct_censoring`
+How readings become contacts: `mode` 'per_tactel' (a contact per active tactel) or 'per_pad'
+(one per pad and frame, from a quadric fitted to its depth map; one per tactel in a frame with
+fewer than six active); `local_normals` (normals from the pad's depth map, else the pad normal); `correct_censoring`
 (remove the bias of readings that barely passed the noise floor); `fallback_normal_sigma`
 [rad], the slope uncertainty where the depth map cannot measure it.)doc")
       .def(py::init([](const std::string& mode, bool local_normals, bool correct_censoring,
@@ -507,24 +513,30 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
           "(M,) time of the last contact fused into each point [s]")
       .def(
           "confident",
-          [](const PyContactCloud& c, std::uint32_t min_observations, double max_sigma) {
+          [](const PyContactCloud& c, std::uint32_t min_observations, double max_sigma,
+             double max_normal_sigma) {
             py::array_t<bool> out(static_cast<py::ssize_t>(c.impl->size()));
             for (std::size_t i = 0; i < c.impl->size(); ++i) {
-              out.mutable_data()[i] = c.impl->confident(i, min_observations, max_sigma);
+              out.mutable_data()[i] =
+                  c.impl->confident(i, min_observations, max_sigma, max_normal_sigma);
             }
             return out;
           },
           py::kw_only(), py::arg("min_observations") = 1,
           py::arg("max_sigma") = std::numeric_limits<double>::infinity(),
+          py::arg("max_normal_sigma") = std::numeric_limits<double>::infinity(),
           "(M,) bool: points with at least min_observations contacts whose largest standard "
-          "deviation is at most max_sigma [m]")
+          "deviation is at most max_sigma [m] and smallest (across the surface) at most "
+          "max_normal_sigma [m]")
       .def(
           "to_point_cloud",
-          [](const PyContactCloud& c, std::uint32_t min_observations, double max_sigma) {
-            return c.impl->to_point_cloud(min_observations, max_sigma);
+          [](const PyContactCloud& c, std::uint32_t min_observations, double max_sigma,
+             double max_normal_sigma) {
+            return c.impl->to_point_cloud(min_observations, max_sigma, max_normal_sigma);
           },
           py::kw_only(), py::arg("min_observations") = 1,
           py::arg("max_sigma") = std::numeric_limits<double>::infinity(),
+          py::arg("max_normal_sigma") = std::numeric_limits<double>::infinity(),
           "The confident points as a PointCloud with fields 'observations', 'cov_xx' .. "
           "'cov_zz', 'last_time' (and normals with the surfel policy).")
       .def("clear", [](PyContactCloud& c) { c.impl->clear(); })

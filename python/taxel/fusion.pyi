@@ -30,7 +30,7 @@ Options that the chosen policy or index does not use must stay at their defaults
     @property
     def association_radius(self) -> float: ...
     def clear(self) -> None: ...
-    def confident(self, *, min_observations: int = 1, max_sigma: float = ...) -> numpy.typing.NDArray[numpy.bool_]: """(M,) bool: points with at least min_observations contacts whose largest standard deviation is at most max_sigma [m]"""
+    def confident(self, *, min_observations: int = 1, max_sigma: float = ..., max_normal_sigma: float = ...) -> numpy.typing.NDArray[numpy.bool_]: """(M,) bool: points with at least min_observations contacts whose largest standard deviation is at most max_sigma [m] and smallest (across the surface) at most max_normal_sigma [m]"""
     @property
     def covariances(self) -> numpy.typing.NDArray[numpy.float64]: ...
     @property
@@ -52,7 +52,7 @@ Options that the chosen policy or index does not use must stay at their defaults
     @property
     def policy(self) -> str: ...
     def reserve(self, n: int) -> None: ...
-    def to_point_cloud(self, *, min_observations: int = 1, max_sigma: float = ...) -> taxel.PointCloud: """The confident points as a PointCloud with fields 'observations', 'cov_xx' .. 'cov_zz', 'last_time' (and normals with the surfel policy)."""
+    def to_point_cloud(self, *, min_observations: int = 1, max_sigma: float = ..., max_normal_sigma: float = ...) -> taxel.PointCloud: """The confident points as a PointCloud with fields 'observations', 'cov_xx' .. 'cov_zz', 'last_time' (and normals with the surfel policy)."""
 
 INDEXES: tuple
 POLICIES: tuple

@@ -17,8 +17,9 @@ import taxel.sim
 
 
 class ContactOptions:
-    """How readings become contacts: `mode` 'per_tactel' (a contact per active tactel) or 'per_pad';
-`local_normals` (normals from the pad's depth map, else the pad normal); `correct_censoring`
+    """How readings become contacts: `mode` 'per_tactel' (a contact per active tactel) or 'per_pad'
+(one per pad and frame, from a quadric fitted to its depth map; one per tactel in a frame with
+fewer than six active); `local_normals` (normals from the pad's depth map, else the pad normal); `correct_censoring`
 (remove the bias of readings that barely passed the noise floor); `fallback_normal_sigma`
 [rad], the slope uncertainty where the depth map cannot measure it."""
     def __init__(self, mode: str = 'per_tactel', local_normals: bool = True, correct_censoring: bool = True, fallback_normal_sigma: float = 0.15) -> None: ...

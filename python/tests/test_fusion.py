@@ -147,6 +147,14 @@ def test_confidence_filter(rng):
     assert not cloud.confident(max_sigma=5e-4)[-1]
     with pytest.raises(ValueError):
         cloud.confident(max_sigma=-1.0)
+    # max_normal_sigma: against the smallest eigenvalue of each covariance.
+    low = np.sqrt(np.linalg.eigvalsh(cloud.covariances)[:, 0])
+    ranked = np.sort(low)
+    bound = float(0.5 * (ranked[4] + ranked[5]))  # between two points, not on one
+    np.testing.assert_array_equal(cloud.confident(max_normal_sigma=bound), low <= bound)
+    assert len(cloud.to_point_cloud(max_normal_sigma=bound)) == int((low <= bound).sum())
+    with pytest.raises(ValueError):
+        cloud.confident(max_normal_sigma=-1.0)
 
 
 def test_readings_to_contacts_equal_the_simulators():

@@ -680,6 +680,29 @@ TEST_CASE("to_point_cloud: full covariances, normals and confidence filters",
       CHECK(kept.size() == expected);
     }
   }
+  // The smallest standard deviation (across the surface), against the eigen-solver too; the
+  // points' normal sigmas spread over the thresholds, so each keeps some and drops some.
+  std::size_t some_kept = 0, some_dropped = 0;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double max_normal : {0.03e-3, 0.05e-3, 0.1e-3, 0.3e-3}) {
+    const auto kept = cloud.to_point_cloud({1, inf, max_normal});
+    std::size_t expected = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const auto id = static_cast<taxel::index::PointId>(i);
+      const double low =
+          Eigen::SelfAdjointEigenSolver<taxel::Mat3d>(cloud.covariance(id)).eigenvalues()(0);
+      const bool pass = std::sqrt(low) <= max_normal;
+      CHECK(cloud.confident(id, {1, inf, max_normal}) == pass);
+      expected += pass ? 1 : 0;
+    }
+    CHECK(kept.size() == expected);
+    some_kept += expected > 0 ? 1 : 0;
+    some_dropped += expected < cloud.size() ? 1 : 0;
+  }
+  CHECK(some_kept > 0);
+  CHECK(some_dropped > 0);
+  CHECK_THROWS_AS(cloud.to_point_cloud({1, inf, -1.0}), std::invalid_argument);
+  CHECK_THROWS_AS(cloud.to_point_cloud({1, inf, std::nan("")}), std::invalid_argument);
   CHECK(cloud.to_point_cloud({1, 0.0}).size() == 0);
   CHECK_THROWS_AS(cloud.to_point_cloud({1, -1.0}), std::invalid_argument);
   CHECK_THROWS_AS(cloud.to_point_cloud({1, std::nan("")}), std::invalid_argument);

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 #include <taxel/sensor.hpp>
+#include <taxel/sim/exploration.hpp>
+#include <taxel/sim/shapes.hpp>
 
 namespace tsn = taxel::sensor;
 using taxel::Vec3d;
@@ -193,6 +195,56 @@ TEST_CASE("readings to contacts: per pad, the quadric's point above the centroid
   CHECK(std::abs((out[0].position - centre).norm() - R) < 5e-6);
   CHECK(out[0].normal->dot((out[0].position - centre).normalized()) > 1 - 1e-4);
   CHECK(taxel::check_contact(out[0]) == taxel::ContactDefect::ok);
+}
+
+TEST_CASE("readings to contacts: per pad, a light touch gives its tactels one by one", "[sensor]") {
+  const tsn::SensorModel m = noiseless();
+  tsn::ContactExtractor pad(m, {.mode = tsn::ContactMode::per_pad});
+  tsn::ContactExtractor tactel(m, {.mode = tsn::ContactMode::per_tactel});
+  // A 15 mm sphere touched 0.3 mm deep over a tactel centre: a handful of active tactels, too
+  // few for a quadric. A plane through them would put the contact inside the sphere by the
+  // chord sag; the tactels' own contacts lie on it.
+  const double R = 0.015, delta = 0.3e-3;
+  const Vec3d at = m.geometry.tactel(6, 2);
+  const auto depth = [&](double x, double y) {
+    const double dx = x - at.x(), dy = y - at.y();
+    return delta - (R - std::sqrt(R * R - dx * dx - dy * dy));
+  };
+  std::vector<taxel::Contact<double>> by_pad, by_tactel;
+  const std::size_t n = pad.extract(readings(m, depth), Eigen::Isometry3d::Identity(), 0, by_pad);
+  REQUIRE(n >= 1);
+  REQUIRE(n < 6);
+  REQUIRE(tactel.extract(readings(m, depth), Eigen::Isometry3d::Identity(), 0, by_tactel) == n);
+  const Vec3d centre(at.x(), at.y(), R - delta);
+  for (std::size_t i = 0; i < n; ++i) {
+    CHECK(by_pad[i].position == by_tactel[i].position);
+    CHECK(std::abs((by_pad[i].position - centre).norm() - R) < 5e-6);
+  }
+}
+
+TEST_CASE("readings to contacts: per pad, unbiased on a small sphere under noise", "[sensor]") {
+  // Grasps and palpations of a 15 mm sphere with the default noisy pad: the mean signed
+  // distance of the per-pad contacts to the sphere. With a plane or mean for light touches
+  // it was -0.15 mm; the quadric, or the tactels one by one, bring it within 0.02 mm.
+  namespace ts = taxel::sim;
+  ts::ExplorationConfig cfg;
+  cfg.contacts.mode = ts::ContactMode::per_pad;
+  const ts::Sphere sphere(0.015);
+  double sum = 0;
+  std::size_t n = 0;
+  for (const std::uint64_t seed : {1, 2}) {
+    cfg.seed = seed;
+    for (const auto& c : ts::explore_grasps(sphere, cfg, {.grasps = 4}).contacts()) {
+      sum += sphere.signed_distance(c.position);
+      ++n;
+    }
+    for (const auto& c : ts::explore_palpation(sphere, cfg, {.touches = 20}).contacts()) {
+      sum += sphere.signed_distance(c.position);
+      ++n;
+    }
+  }
+  REQUIRE(n > 2000);
+  CHECK(std::abs(sum / double(n)) < 0.02e-3);
 }
 
 TEST_CASE("readings to contacts: bad input is refused", "[sensor]") {

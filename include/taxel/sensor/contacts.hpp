@@ -31,9 +31,11 @@
 //  4. Position. The tactel centre pushed back by the corrected depth along the pad normal:
 //     T_world_pad * (x, y, -d).
 // Per pad, one contact per frame: a quadric d(x, y) = a + g . u + u' H u / 2 (u the offset from
-// the reading-weighted centroid of the active tactels) is fitted to their corrected depths
-// (a plane below six tactels, the mean below three), and the contact is the fitted surface
-// point above the centroid, with the fitted normal there and the fit's own variance of a and g.
+// the reading-weighted centroid of the active tactels) is fitted to their corrected depths, and
+// the contact is the fitted surface point above the centroid, with the fitted normal there and
+// the fit's own variance of a and g. When the active tactels do not determine a quadric (fewer
+// than six, or all in one or two rows), the frame gives one contact per active tactel instead:
+// a plane or a mean fitted there would sit below a convex surface by the chord sag.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -260,7 +262,6 @@ class ContactExtractor {
     const PadGeometry& g = model_.geometry;
     const double p = g.pitch;
     const double vd = depth_variance();
-    const double fb2 = options_.fallback_normal_sigma * options_.fallback_normal_sigma;
     const double x0 = 0.5 * (g.cols - 1), y0 = 0.5 * (g.rows - 1);
     // Reading-weighted centroid of the active tactels, in pitch units from the pad centre.
     double w = 0, wx = 0, wy = 0, corr2 = 0;
@@ -278,45 +279,39 @@ class ContactExtractor {
       }
     }
     const double xc = wx / w, yc = wy / w;
-    // Least squares of the depths on 1, X, Y, X^2, XY, Y^2 (X, Y from the centroid): a quadric
-    // from six tactels, a plane from three, the mean below; a smaller model when the tactels
-    // do not determine the larger one (a pivot vanishes).
-    double sol[6] = {}, inv_diag[3] = {};
-    int m = n >= 6 ? 6 : (n >= 3 ? 3 : 1);
-    for (;; m = (m == 6 ? 3 : 1)) {
-      double ata[36] = {}, atb[6] = {};
-      for (int r = 0; r < g.rows; ++r) {
-        for (int c = 0; c < g.cols; ++c) {
-          const double d = depth_[static_cast<std::size_t>(r) * g.cols + c];
-          if (d == kNone) continue;
-          const double X = c - x0 - xc, Y = r - y0 - yc;
-          const double row[6] = {1.0, X, Y, X * X, X * Y, Y * Y};
-          for (int i = 0; i < m; ++i) {
-            atb[i] += row[i] * d;
-            for (int j = 0; j <= i; ++j) ata[i * 6 + j] += row[i] * row[j];
-          }
+    // Least squares of the depths on 1, X, Y, X^2, XY, Y^2 (X, Y from the centroid). A plane
+    // or a mean cannot say how the surface curves, and its value above the centroid lies below
+    // a convex surface by the chord sag (E[u'Hu] / 2 over the active tactels: about -0.15 mm
+    // on a 15 mm sphere under a 3.4 mm pitch pad). So when fewer than six tactels are active,
+    // or they do not determine a quadric (a pivot vanishes: one or two rows), the tactels give
+    // their contacts one by one.
+    if (n < 6) return per_tactel(counts, T, time, out);
+    double ata[36] = {}, sol[6] = {}, inv_diag[3] = {};
+    for (int r = 0; r < g.rows; ++r) {
+      for (int c = 0; c < g.cols; ++c) {
+        const double d = depth_[static_cast<std::size_t>(r) * g.cols + c];
+        if (d == kNone) continue;
+        const double X = c - x0 - xc, Y = r - y0 - yc;
+        const double row[6] = {1.0, X, Y, X * X, X * Y, Y * Y};
+        for (int i = 0; i < 6; ++i) {
+          sol[i] += row[i] * d;
+          for (int j = 0; j <= i; ++j) ata[i * 6 + j] += row[i] * row[j];
         }
       }
-      if (detail_cholesky(ata, m)) {
-        for (int i = 0; i < m; ++i) sol[i] = atb[i];
-        detail_solve(ata, m, sol);
-        for (int i = 0; i < std::min(m, 3); ++i) {
-          double e[6] = {};
-          e[i] = 1.0;
-          detail_solve(ata, m, e);
-          inv_diag[i] = e[i];
-        }
-        break;
-      }
-      if (m == 1) return 0;  // unreachable: n >= 1 active tactel gives a positive pivot
     }
-    double gx = 0, gy = 0, slope_var = 2 * fb2;
-    if (m >= 3 && options_.local_normals) {
+    if (!detail_cholesky(ata, 6)) return per_tactel(counts, T, time, out);
+    detail_solve(ata, 6, sol);
+    for (int i = 0; i < 3; ++i) {
+      double e[6] = {};
+      e[i] = 1.0;
+      detail_solve(ata, 6, e);
+      inv_diag[i] = e[i];
+    }
+    double gx = 0, gy = 0, slope_var = 0.0;
+    if (options_.local_normals) {
       gx = sol[1] / p;
       gy = sol[2] / p;
       slope_var = vd * (inv_diag[1] + inv_diag[2]) / (p * p);
-    } else if (!options_.local_normals) {
-      slope_var = 0.0;
     }
     const Vec3d n_pad = -Vec3d(gx, gy, 1.0).normalized();
     const double var_a = vd * inv_diag[0] + corr2 / (double(n) * n);
