@@ -85,6 +85,13 @@ TEST_CASE("UniformGrid answers exactly as brute force", "[registration][index]")
         const Vec3d x = Vec3d(uq(rng), uq(rng), uq(rng)) + Vec3d::Constant(offset);
         const double r = q % 2 == 0 ? 0.004 : 0.02;
         REQUIRE(grid.nearest_within(x, r) == brute.nearest_within(x, r));
+        // From a hint (any id, near or far, or out of range): the same answer.
+        const auto nearest = brute.nearest_within(x, 1e9);
+        for (const index::PointId hint : {nearest->id, static_cast<index::PointId>(q % pts.size()),
+                                          static_cast<index::PointId>((7 * q + 3) % pts.size()),
+                                          static_cast<index::PointId>(pts.size())}) {
+          REQUIRE(grid.nearest_within(x, r, hint) == brute.nearest_within(x, r));
+        }
         REQUIRE(grid.knn(x, 7) == brute.knn(x, 7));
         REQUIRE(grid.within(x, r) == brute.within(x, r));
       }
@@ -125,8 +132,14 @@ TEST_CASE("Target: PCA normals, exact nearest with the closest-point field, erro
   for (int q = 0; q < 400; ++q) {
     const Vec3d dir = Vec3d(g(rng), g(rng), g(rng)).normalized();
     const Vec3d x = dir * (0.04 + 0.02 * g(rng));
+    const auto nearest = brute.nearest_within(x, 1.0);
     for (const double r : {0.001, 0.005, 0.03, 1.0}) {
       REQUIRE(tg.nearest_within(x, r) == brute.nearest_within(x, r));
+      // Searched from a hint (the answer, a neighbour of it, any point): the same answer.
+      for (const index::PointId hint :
+           {nearest->id, (nearest->id + 1) % 4000u, static_cast<index::PointId>(q * 9 % 4000)}) {
+        REQUIRE(tg.nearest_within(x, r, hint) == brute.nearest_within(x, r));
+      }
     }
     const auto approx = tg.field_nearest(x);
     if (approx) {  // within half a field cell diagonal of exact
@@ -412,6 +425,13 @@ TEST_CASE("ObjectLibrary recognises partial, noisy, randomly posed clouds",
   add("cube 50", sim::Box(Vec3d(0.025, 0.025, 0.025)));
   add("bar 120 x 40 x 20", sim::Box(Vec3d(0.06, 0.02, 0.01)));
   REQUIRE(lib.size() == 7);
+  // The same models recognised on one thread and on three.
+  ObjectLibrary<double> serial(LibraryConfig{.threads = 1});
+  ObjectLibrary<double> threaded(LibraryConfig{.threads = 3});
+  for (std::size_t m = 0; m < lib.size(); ++m) {
+    serial.add(lib.name(m), objects[m].sample(8000, 1));
+    threaded.add(lib.name(m), objects[m].sample(8000, 1));
+  }
 
   std::mt19937_64 rng(2024);
   std::uniform_real_distribution<double> u(-0.2, 0.2);
@@ -427,6 +447,20 @@ TEST_CASE("ObjectLibrary recognises partial, noisy, randomly posed clouds",
       const PointCloud<double> cloud = transformed(objects[o].touch(100 + 13 * trial + o), T);
       const ObjectRecognition r = lib.recognize(cloud);
       REQUIRE(r.ok());
+      if (trial < 2) {  // the same answer, to the bit, on one thread and on three
+        const ObjectRecognition one = serial.recognize(cloud);
+        const ObjectRecognition three = threaded.recognize(cloud);
+        for (const ObjectRecognition* other : {&one, &three}) {
+          REQUIRE(other->ranking.size() == r.ranking.size());
+          CHECK(other->best == r.best);
+          for (std::size_t k = 0; k < r.ranking.size(); ++k) {
+            CHECK(other->ranking[k].model == r.ranking[k].model);
+            CHECK(other->ranking[k].score == r.ranking[k].score);
+            CHECK(other->ranking[k].starts_stopped_early == r.ranking[k].starts_stopped_early);
+            CHECK(other->ranking[k].transform.matrix() == r.ranking[k].transform.matrix());
+          }
+        }
+      }
       REQUIRE(r.ranking.size() == 7);
       CHECK(std::is_sorted(
           r.ranking.begin(), r.ranking.end(),

@@ -159,6 +159,48 @@ class UniformGrid {
     return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
   }
 
+  /// The same answer as nearest_within(q, r), searched from a hint: any point id whose
+  /// distance to q bounds the answer's. Only the cells meeting the ball of that radius are
+  /// read, so a hint near the answer (the previous iteration's match in ICP, where the query
+  /// moved a little) reads a few cells and never the outward shells. A hint farther
+  /// than r, or out of range, falls back to the search without one.
+  [[nodiscard]] std::optional<Neighbor<S>> nearest_within(const Vec3<S>& q, S r,
+                                                          PointId hint) const {
+    if (points_.empty() || !q.allFinite() || !(r >= S(0)) || hint >= points_.size()) {
+      return nearest_within(q, r);
+    }
+    const S h2 = squared_distance(points_[hint], q);
+    if (!(h2 <= r * r)) return nearest_within(q, r);
+    // The cells a point within sqrt(h2) of q can fall in, padded against the rounding of
+    // cell coordinates; a ball over more than three cells per axis goes the general way.
+    const double reach = std::sqrt(static_cast<double>(h2)) / static_cast<double>(cell_) + 1e-3;
+    std::array<int, 3> lo{}, hi{};
+    const Vec3<S> c = coord(q);
+    for (int a = 0; a < 3; ++a) {
+      const auto ua = static_cast<std::size_t>(a);
+      const double x = static_cast<double>(c[a]);
+      const double top = dims_[ua] - 1;
+      const double l = std::floor(x - reach), h = std::floor(x + reach);
+      if (!(h - l <= 2.0)) return nearest_within(q, r);
+      lo[ua] = static_cast<int>(std::clamp(l, 0.0, top));
+      hi[ua] = static_cast<int>(std::clamp(h, 0.0, top));
+    }
+    Neighbor<S> best{hint, h2};  // the hint is in the ball, so it is visited again
+    for (int z = lo[2]; z <= hi[2]; ++z) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
+        for (std::uint32_t s = start_[row + lo[0]], e = start_[row + hi[0] + 1]; s < e; ++s) {
+          const S d2 = squared_distance(sorted_[s], q);
+          const PointId id = order_[s];
+          if (d2 < best.squared_distance || (d2 == best.squared_distance && id < best.id)) {
+            best = {id, d2};
+          }
+        }
+      }
+    }
+    return best;
+  }
+
   /// The min(k, size()) closest points, ordered by `closer`.
   [[nodiscard]] std::vector<Neighbor<S>> knn(const Vec3<S>& q, std::size_t k) const {
     k = std::min(k, size());

@@ -182,18 +182,35 @@ struct PointToPlane {
     // whose null space is exactly the motions the target's shape leaves free (a plane's
     // in-plane slides and spin, a sphere's rotations about its centre, a cylinder's axis), so
     // degeneracy is decided on hq and the step is taken in the directions it constrains.
-    Mat6d h = Mat6d::Zero();
-    Mat6d hq = Mat6d::Zero();
+    // Lower triangles only, in plain arrays (a third of the products of full outer ones).
+    std::array<double, 21> hl{}, hql{};
     Vec6d g = Vec6d::Zero();
+    const double inv_len = 1.0 / len;
     for (const auto& c : cs) {
-      Vec6d j;
-      j.template head<3>() = (c.p - centre).cross(c.n) / len;
-      j.template tail<3>() = c.n;
-      const double r = c.n.dot(c.p - c.q);
-      h.noalias() += (c.weight * j) * j.transpose();
-      g.noalias() += (c.weight * r) * j;
-      j.template head<3>() = (c.q - centre).cross(c.n) / len;
-      hq.noalias() += (c.weight * j) * j.transpose();
+      std::array<double, 6> j, jq;
+      const Vec3d a = (c.p - centre).cross(c.n) * inv_len;
+      const Vec3d b = (c.q - centre).cross(c.n) * inv_len;
+      j = {a.x(), a.y(), a.z(), c.n.x(), c.n.y(), c.n.z()};
+      jq = {b.x(), b.y(), b.z(), c.n.x(), c.n.y(), c.n.z()};
+      const double wr = c.weight * c.n.dot(c.p - c.q);
+      std::size_t k = 0;
+      for (std::size_t u = 0; u < 6; ++u) {
+        const double wj = c.weight * j[u];
+        const double wjq = c.weight * jq[u];
+        g(static_cast<Eigen::Index>(u)) += wr * j[u];
+        for (std::size_t v = 0; v <= u; ++v, ++k) {
+          hl[k] += wj * j[v];
+          hql[k] += wjq * jq[v];
+        }
+      }
+    }
+    Mat6d h, hq;
+    for (std::size_t u = 0, k = 0; u < 6; ++u) {
+      for (std::size_t v = 0; v <= u; ++v, ++k) {
+        const auto iu = static_cast<Eigen::Index>(u), iv = static_cast<Eigen::Index>(v);
+        h(iu, iv) = h(iv, iu) = hl[k];
+        hq(iu, iv) = hq(iv, iu) = hql[k];
+      }
     }
     const Eigen::SelfAdjointEigenSolver<Mat6d> eig(hq);
     const double top = eig.eigenvalues()(5);
@@ -341,6 +358,7 @@ class Icp {
                   int& iterations) {
     double previous_rmse = std::numeric_limits<double>::infinity();
     Outcome last{};
+    hints_.assign(active_->size(), kNoHint);  // a new stage: no previous matches
     for (int it = 0; it < cfg_.max_iterations; ++it) {
       const double rmse = correspond(target, t);
       if (pairs_.size() < need) {
@@ -383,16 +401,23 @@ class Icp {
     const auto& nrm = target.normals();
     const S gate = static_cast<S>(std::min(cfg_.max_distance, 1e300));
     const double gate2 = cfg_.max_distance * cfg_.max_distance;
-    for (const Vec3d& s : *active_) {
-      const Vec3d p = t * s;
+    for (std::size_t i = 0; i < active_->size(); ++i) {
+      const Vec3d p = t * (*active_)[i];
       const Vec3<S> ps = p.template cast<S>();
       index::PointId id = 0;
       if (const auto approx = approximate_ ? target.field_nearest(ps) : std::nullopt) {
         id = *approx;
-      } else if (const auto nb = target.nearest_within(ps, gate)) {
-        id = nb->id;
       } else {
-        continue;
+        // Exact, searched from the point's previous match: after a small update the match
+        // moves little, so the ball it bounds holds few cells (the same answer as without).
+        const auto nb = hints_[i] == kNoHint ? target.nearest_within(ps, gate)
+                                             : target.nearest_within(ps, gate, hints_[i]);
+        if (!nb) {
+          hints_[i] = kNoHint;
+          continue;
+        }
+        id = nb->id;
+        hints_[i] = id;
       }
       Correspondence c;
       c.p = p;
@@ -439,6 +464,8 @@ class Icp {
     return res;
   }
 
+  static constexpr index::PointId kNoHint = std::numeric_limits<index::PointId>::max();
+
   IcpConfig cfg_;
   Kernel kernel_;
   std::vector<Vec3d> src_;
@@ -447,6 +474,7 @@ class Icp {
   bool approximate_ = false;
   std::vector<Correspondence> pairs_;
   std::vector<double> scratch_;
+  std::vector<index::PointId> hints_;  // each active point's last exact match, or kNoHint
 };
 
 }  // namespace taxel::registration

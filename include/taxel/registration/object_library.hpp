@@ -14,6 +14,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -23,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "taxel/core/parallel.hpp"
 #include "taxel/core/point_cloud.hpp"
 #include "taxel/registration/icp.hpp"
 #include "taxel/registration/target.hpp"
@@ -64,8 +66,8 @@ struct LibraryConfig {
   int rotation_starts = 24;         ///< starts from the cube rotation group, [0, 24]
   int refine_best = 2;              ///< coarse starts refined per model, >= 1
   int exact_models = 3;             ///< best models refined with exact correspondences, >= 1
-  /// A start whose coarse RMS distance after 3 iterations exceeds this multiple of the best
-  /// coarse result so far (any model) stops there.
+  /// A start whose inlier RMSE after 3 coarse iterations exceeds this multiple of the best
+  /// truncated RMS distance any start (of any model) reached by then stops there.
   double hopeless_factor = 3.0;
   /// Cell of the models' closest-point fields, used by the coarse stage [m] (TargetConfig).
   double field_cell = 2e-3;
@@ -73,6 +75,9 @@ struct LibraryConfig {
   double score_gate = 0.01;
   /// `unknown` when the best model's score exceeds this.
   double unknown_score = 3e-3;
+  /// Threads of one recognition (0: every core). The starts, the refinements and the scores
+  /// are shared out over them; the answer does not depend on the number.
+  unsigned threads = 0;
 };
 
 /// How well one model explains the cloud.
@@ -174,8 +179,35 @@ class ObjectLibrary {
     const std::vector<Vec3<S>> coarse = subsample(pts, cfg_.coarse_points);
     const std::vector<Vec3<S>> fine = subsample(pts, cfg_.refine_points);
 
-    std::vector<Mat3d> rotations;  // of the cloud's frame into the model's, before centring
+    // Every (model, start) pair, in model order; the starts align the cloud's principal axes
+    // with the model's, then the cube rotations, each about the centroids.
     const std::vector<Mat3d> group = cube_rotations();
+    struct Start {
+      std::size_t model = 0;
+      Isometry3d transform = Isometry3d::Identity();
+      IcpResult early;
+      double score = std::numeric_limits<double>::infinity();  // coarse truncated RMS
+      bool valid = false;
+      bool stopped = false;
+    };
+    std::vector<Start> starts;
+    for (std::size_t mi = 0; mi < models_.size(); ++mi) {
+      const Target<S>& tg = models_[mi].target;
+      const auto add = [&](const Mat3d& r) {
+        Start st;
+        st.model = mi;
+        st.transform.linear() = r;
+        st.transform.translation() = tg.centroid() - r * centre;
+        starts.push_back(std::move(st));
+      };
+      if (cfg_.pca_starts) {
+        for (const Vec3d& d :
+             {Vec3d(1, 1, 1), Vec3d(-1, -1, 1), Vec3d(-1, 1, -1), Vec3d(1, -1, -1)}) {
+          add(tg.principal_axes() * d.asDiagonal() * axes.transpose());
+        }
+      }
+      for (int k = 0; k < cfg_.rotation_starts; ++k) add(group[static_cast<std::size_t>(k)]);
+    }
 
     IcpConfig coarse_cfg;
     coarse_cfg.max_iterations = std::min(3, cfg_.coarse_iterations);
@@ -183,81 +215,93 @@ class ObjectLibrary {
     coarse_cfg.translation_tolerance = 1e-4;
     coarse_cfg.rotation_tolerance = 1e-3;
     coarse_cfg.approximate = true;
-    Icp<PointToPlane> early(coarse_cfg);
+    const IcpConfig early_cfg = coarse_cfg;
     coarse_cfg.max_iterations = std::max(1, cfg_.coarse_iterations - 3);
-    Icp<PointToPlane> rest(coarse_cfg);
+    const IcpConfig rest_cfg = coarse_cfg;
     // Refinement: first on the closest-point fields, then exact from there.
     IcpConfig approx_cfg = cfg_.refine;
     approx_cfg.approximate = true;
-    Icp<PointToPlane> refine_approx(approx_cfg);
-    Icp<PointToPlane> refine(cfg_.refine);
-    double best_coarse = std::numeric_limits<double>::infinity();
+    const std::span<const Vec3<S>> coarse_span(coarse), fine_span(fine);
 
-    for (std::size_t mi = 0; mi < models_.size(); ++mi) {
-      const Target<S>& tg = models_[mi].target;
-      rotations.clear();
-      if (cfg_.pca_starts) {
-        for (const Vec3d& d :
-             {Vec3d(1, 1, 1), Vec3d(-1, -1, 1), Vec3d(-1, 1, -1), Vec3d(1, -1, -1)}) {
-          rotations.push_back(tg.principal_axes() * d.asDiagonal() * axes.transpose());
-        }
-      }
-      for (int k = 0; k < cfg_.rotation_starts; ++k)
-        rotations.push_back(group[static_cast<std::size_t>(k)]);
-
-      ModelMatch match;
-      match.name = models_[mi].name;
-      match.model = mi;
-      std::vector<std::pair<double, Isometry3d>> starts;  // coarse rmse, transform
-      for (const Mat3d& r : rotations) {
-        Isometry3d t = Isometry3d::Identity();
-        t.linear() = r;
-        t.translation() = tg.centroid() - r * centre;
-        ++match.starts;
-        IcpResult res = early.align(tg, std::span<const Vec3<S>>(coarse), t);
-        if (res.status == Status::invalid_input) continue;
-        if (res.rmse > cfg_.hopeless_factor * best_coarse || res.inliers < 6) {
-          ++match.starts_stopped_early;
-        } else {
-          res = rest.align(tg, std::span<const Vec3<S>>(coarse), res.transform);
-        }
-        const double s = truncated_rms(tg, coarse, res.transform, true);
-        best_coarse = std::min(best_coarse, s);
-        starts.emplace_back(s, res.transform);
-      }
-      std::sort(starts.begin(), starts.end(),
-                [](const auto& a, const auto& b) { return a.first < b.first; });
-      // The best starts refined on the closest-point field; the best of them kept.
-      match.score = std::numeric_limits<double>::infinity();
-      const std::size_t refined =
-          std::min<std::size_t>(starts.size(), static_cast<std::size_t>(cfg_.refine_best));
-      for (std::size_t k = 0; k < refined; ++k) {
-        const IcpResult res =
-            refine_approx.align(tg, std::span<const Vec3<S>>(fine), starts[k].second);
-        const double s = truncated_rms(tg, fine, res.transform, true);
-        if (s < match.score) {
-          match.score = s;
-          match.transform = res.transform;
-        }
-      }
-      out.ranking.push_back(std::move(match));
-    }
+    // Each stage runs its items on the workers, each worker with its own ICP workspace; an
+    // item's result depends on its inputs alone, so the answer is the same on any number of
+    // threads. Stage 1: three coarse iterations from every start.
+    for_each_item(
+        starts.size(), [&] { return Icp<PointToPlane>(early_cfg); },
+        [&](Icp<PointToPlane>& icp, std::size_t i) {
+          Start& st = starts[i];
+          const Target<S>& tg = models_[st.model].target;
+          st.early = icp.align(tg, coarse_span, st.transform);
+          st.valid = st.early.status != Status::invalid_input;
+          if (st.valid) st.score = truncated_rms(tg, coarse, st.early.transform, true);
+        });
+    // A start whose early RMSE exceeds hopeless_factor times the best early score of any
+    // model stops there (a threshold that does not depend on the order of the starts).
+    double best_early = std::numeric_limits<double>::infinity();
+    for (const Start& st : starts) best_early = std::min(best_early, st.score);
+    // Stage 2: the remaining coarse iterations of the promising starts.
+    for_each_item(
+        starts.size(), [&] { return Icp<PointToPlane>(rest_cfg); },
+        [&](Icp<PointToPlane>& icp, std::size_t i) {
+          Start& st = starts[i];
+          if (!st.valid) return;
+          const Target<S>& tg = models_[st.model].target;
+          if (st.early.rmse > cfg_.hopeless_factor * best_early || st.early.inliers < 6) {
+            st.stopped = true;
+            st.transform = st.early.transform;
+            return;
+          }
+          st.transform = icp.align(tg, coarse_span, st.early.transform).transform;
+          st.score = truncated_rms(tg, coarse, st.transform, true);
+        });
+    // Stage 3, per model: its best starts refined on the closest-point field, the best kept.
+    out.ranking.resize(models_.size());
+    for_each_item(
+        models_.size(), [&] { return Icp<PointToPlane>(approx_cfg); },
+        [&](Icp<PointToPlane>& icp, std::size_t mi) {
+          const Target<S>& tg = models_[mi].target;
+          ModelMatch& match = out.ranking[mi];
+          match.name = models_[mi].name;
+          match.model = mi;
+          std::vector<std::pair<double, std::size_t>> order;  // coarse score, start
+          for (std::size_t i = 0; i < starts.size(); ++i) {
+            if (starts[i].model != mi) continue;
+            ++match.starts;
+            if (!starts[i].valid) continue;
+            if (starts[i].stopped) ++match.starts_stopped_early;
+            order.emplace_back(starts[i].score, i);
+          }
+          std::sort(order.begin(), order.end());
+          match.score = std::numeric_limits<double>::infinity();
+          const std::size_t refined =
+              std::min<std::size_t>(order.size(), static_cast<std::size_t>(cfg_.refine_best));
+          for (std::size_t k = 0; k < refined; ++k) {
+            const IcpResult res = icp.align(tg, fine_span, starts[order[k].second].transform);
+            const double s = truncated_rms(tg, fine, res.transform, true);
+            if (s < match.score) {
+              match.score = s;
+              match.transform = res.transform;
+            }
+          }
+        });
     // The leading models refined exactly; every model scored exactly on the whole cloud.
     std::stable_sort(out.ranking.begin(), out.ranking.end(),
                      [](const ModelMatch& a, const ModelMatch& b) { return a.score < b.score; });
-    for (std::size_t k = 0; k < out.ranking.size(); ++k) {
-      ModelMatch& match = out.ranking[k];
-      const Target<S>& tg = models_[match.model].target;
-      if (k < static_cast<std::size_t>(cfg_.exact_models)) {
-        const IcpResult res = refine.align(tg, std::span<const Vec3<S>>(fine), match.transform);
-        match.transform = res.transform;
-        match.rmse = res.rmse;
-        match.inlier_fraction = res.inlier_fraction;
-        match.icp_status = res.status;
-        match.exact = true;
-      }
-      match.score = truncated_rms(tg, pts, match.transform, false);
-    }
+    for_each_item(
+        out.ranking.size(), [&] { return Icp<PointToPlane>(cfg_.refine); },
+        [&](Icp<PointToPlane>& icp, std::size_t k) {
+          ModelMatch& match = out.ranking[k];
+          const Target<S>& tg = models_[match.model].target;
+          if (k < static_cast<std::size_t>(cfg_.exact_models)) {
+            const IcpResult res = icp.align(tg, fine_span, match.transform);
+            match.transform = res.transform;
+            match.rmse = res.rmse;
+            match.inlier_fraction = res.inlier_fraction;
+            match.icp_status = res.status;
+            match.exact = true;
+          }
+          match.score = truncated_rms(tg, pts, match.transform, false);
+        });
     std::stable_sort(out.ranking.begin(), out.ranking.end(),
                      [](const ModelMatch& a, const ModelMatch& b) { return a.score < b.score; });
     out.margin = out.ranking.size() > 1 ? out.ranking[1].score - out.ranking[0].score : 0.0;
@@ -271,6 +315,20 @@ class ObjectLibrary {
     std::string name;
     Target<S> target;
   };
+
+  // Calls item(workspace, i) for every i in [0, n) on up to cfg_.threads threads, each thread
+  // with one workspace made by make() and handed items one at a time.
+  template <class Make, class Item>
+  void for_each_item(std::size_t n, Make&& make, Item&& item) const {
+    const std::size_t workers = std::min<std::size_t>(resolve_threads(cfg_.threads), n);
+    std::atomic<std::size_t> next{0};
+    parallel_for(workers, static_cast<unsigned>(workers), [&](std::size_t) {
+      auto workspace = make();
+      for (std::size_t i; (i = next.fetch_add(1, std::memory_order_relaxed)) < n;) {
+        item(workspace, i);
+      }
+    });
+  }
 
   static std::vector<Vec3<S>> subsample(const std::vector<Vec3<S>>& pts, std::size_t n) {
     const std::size_t m = std::min(n, pts.size());

@@ -103,19 +103,40 @@ class Target {
   /// (its distance to the cell centre minus half the cell diagonal: far queries end at once).
   [[nodiscard]] std::optional<index::Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
     if (!(r >= S(0)) || !q.allFinite()) return std::nullopt;
+    if (const auto cell = field_cell_of(q)) {
+      const index::PointId hint = field_[*cell];
+      const Vec3d p = grid_.points()[hint].template cast<double>();
+      const double lower = (field_centre(*cell) - p).norm() - field_half_diagonal_;
+      if (lower > static_cast<double>(r)) return std::nullopt;
+      // The stored point is within `upper`, so the nearest is too: near the surface the grid
+      // reads the few cells of that ball, farther the kd-tree searches no farther.
+      const double upper = (q.template cast<double>() - p).norm();
+      if (upper <= static_cast<double>(r)) {
+        if (upper <= kHintCells * static_cast<double>(grid_.cell())) {
+          return grid_.nearest_within(q, r, hint);
+        }
+        return tree_.nearest_within(q, static_cast<S>(upper) * (S(1) + S(1e-6)) + S(1e-12));
+      }
+    }
     const S near = S(3) * grid_.cell();
     if (r <= near) return grid_.nearest_within(q, r);
     if (auto nb = grid_.nearest_within(q, near)) return nb;  // nothing nearer lies beyond
-    if (const auto cell = field_cell_of(q)) {
-      const Vec3d qd = q.template cast<double>();
-      const Vec3d p = grid_.points()[field_[*cell]].template cast<double>();
-      const double lower = (field_centre(*cell) - p).norm() - field_half_diagonal_;
-      if (lower > static_cast<double>(r)) return std::nullopt;
-      // The stored point is within `upper`, so the nearest is too; search no farther.
-      const double upper = (qd - p).norm();
-      if (upper < static_cast<double>(r)) r = static_cast<S>(upper) * (S(1) + S(1e-6)) + S(1e-12);
-    }
     return tree_.nearest_within(q, r);
+  }
+
+  /// The same answer as nearest_within(q, r), searched from `hint`: any point id whose
+  /// distance to q bounds the answer's (in ICP, the previous iteration's match of the same
+  /// source point). A hint within three grid cells of q reads only the cells of the ball it
+  /// bounds; otherwise, or out of range, the search runs without it.
+  [[nodiscard]] std::optional<index::Neighbor<S>> nearest_within(const Vec3<S>& q, S r,
+                                                                 index::PointId hint) const {
+    if (hint < size() && q.allFinite() && r >= S(0)) {
+      const S near = S(3) * grid_.cell();
+      const S h2 = index::squared_distance(grid_.points()[hint], q);
+      // The answer lies within sqrt(h2) <= min(r, near): the grid alone finds it.
+      if (h2 <= r * r && h2 <= near * near) return grid_.nearest_within(q, std::min(r, near), hint);
+    }
+    return nearest_within(q, r);
   }
 
   /// The id of the point nearest to the centre of q's closest-point-field cell, or nothing
@@ -160,7 +181,7 @@ class Target {
 
   std::optional<std::size_t> field_cell_of(const Vec3<S>& q) const {
     if (field_.empty()) return std::nullopt;
-    const Vec3d c = (q.template cast<double>() - field_lo_) / field_cell_;
+    const Vec3d c = (q.template cast<double>() - field_lo_) * field_inv_cell_;
     if (!(c.minCoeff() >= 0.0) || !(c.x() < field_dims_[0]) || !(c.y() < field_dims_[1]) ||
         !(c.z() < field_dims_[2])) {
       return std::nullopt;
@@ -211,6 +232,7 @@ class Target {
     }
     for (std::size_t a = 0; a < 3; ++a) field_dims_[a] = static_cast<int>(n[a]);
     field_cell_ = cell;
+    field_inv_cell_ = 1.0 / cell;
     field_half_diagonal_ = 0.5 * std::sqrt(3.0) * cell;
     const std::size_t cells = static_cast<std::size_t>(field_dims_[0]) *
                               static_cast<std::size_t>(field_dims_[1]) *
@@ -254,12 +276,17 @@ class Target {
     }
   }
 
+  // A field point this many grid cells from the query bounds a grid search; beyond, the
+  // kd-tree's.
+  static constexpr double kHintCells = 1.0;
+
   index::UniformGrid<S> grid_;  // owns the points
   index::KdTree<S> tree_;
   std::vector<index::PointId> field_;  // closest-point field, x fastest
   std::array<int, 3> field_dims_{0, 0, 0};
   Vec3d field_lo_ = Vec3d::Zero();
   double field_cell_ = 0.0;
+  double field_inv_cell_ = 0.0;
   double field_half_diagonal_ = 0.0;
   std::vector<Vec3<S>> normals_;
   Vec3d centroid_ = Vec3d::Zero();
