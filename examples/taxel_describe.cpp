@@ -48,6 +48,8 @@ options:
   --min-area N          HPR components below N pixels are removed (default 50)
   --threshold G         edged when the largest HPR's contour gradient exceeds G (default 25)
   --degree D            RecEdgeless polynomial degree (default 2)
+  --threads N           describe the frames of a stack on N threads for --format libsvm
+                        (default 0: every core; the output does not depend on N)
   -o FILE               write to FILE instead of standard output
   -h, --help            show this help
   --version             show taxel's version
@@ -63,6 +65,7 @@ struct Options {
   bool hybrid = false;
   ti::RecognizerConfig cfg;
   double threshold = 25.0;
+  unsigned threads = 0;
   std::string output;
   std::vector<std::string> inputs;
 };
@@ -108,6 +111,8 @@ Options parse(int argc, char** argv) {
     } else if (a == "--degree") {
       o.cfg.edgeless.degree =
           args.number<int>(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+    } else if (a == "--threads") {
+      o.threads = args.number<unsigned>(0, 4096);
     } else if (a == "-o") {
       o.output = std::string(value());
     } else if (a.size() > 1 && a[0] == '-') {
@@ -189,9 +194,13 @@ std::string describe_libsvm(const Options& opt) {
   std::vector<Eigen::VectorXd> rows;
   for (const std::string& path : opt.inputs) {
     const taxel::io::ImageStack stack = load_image(path);
-    ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg, ti::GradientThreshold{opt.threshold});
+    const ti::Recognizer<> rec(stack.rows, stack.cols, opt.cfg,
+                               ti::GradientThreshold{opt.threshold});
+    const std::vector<ti::Recognition> described = ti::recognize_all(
+        rec, static_cast<std::size_t>(stack.frames),
+        [&](std::size_t f) { return stack.frame(static_cast<Eigen::Index>(f)); }, opt.threads);
     for (Eigen::Index f = 0; f < stack.frames; ++f) {
-      const ti::Recognition& r = rec.recognize(stack.frame(f));
+      const ti::Recognition& r = described[static_cast<std::size_t>(f)];
       if (!r.ok()) {
         bad_data(taxel_cli::input_name(path) + " frame " + std::to_string(f) + ": " +
                  std::string(taxel::to_string(r.status)) + ": " + r.message);

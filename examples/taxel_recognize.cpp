@@ -41,6 +41,8 @@ options:
   --unknown D        answer unknown above this score (default 0.003)
   --gate D           points farther than D count as D in the score (default 0.01)
   --starts N         cube-rotation starts, 0..24 (default 24)
+  --threads N        share the starts out over N threads (default 0: every core; the answer
+                     does not depend on N)
   --format text|json|csv  how the result is printed (default text; csv: a row per model,
                      best first, with its pose as translation, axis, angle and the 16 numbers
                      of the transform, row-major)
@@ -80,6 +82,8 @@ int main(int argc, char** argv) {
       cfg.score_gate = args.length(-kInf, kInf);
     } else if (a == "--starts") {
       cfg.rotation_starts = args.number<int>(-1000, 1000);
+    } else if (a == "--threads") {
+      cfg.threads = args.number<unsigned>(0, 4096);
     } else if (a == "--scale") {
       scale = args.number<double>(1e-300, 1e300);
     } else if (a == "--mesh-spacing") {

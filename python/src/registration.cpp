@@ -228,11 +228,12 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
 
   py::class_<reg::ObjectLibrary<double>>(m, "ObjectLibrary", R"doc(
 Named object models; recognize() ranks them by how well each explains a cloud (multi-start
-point-to-plane ICP, then a truncated RMS score [m]).)doc")
+point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its starts out over
+`threads` threads (0: every core); the answer does not depend on the number.)doc")
       .def(py::init([](int coarse_iterations, std::size_t coarse_points, std::size_t refine_points,
                        double coarse_trim, bool pca_starts, int rotation_starts, int refine_best,
                        int exact_models, double hopeless_factor, double field_cell,
-                       double score_gate, double unknown_score) {
+                       double score_gate, double unknown_score, unsigned threads) {
              reg::LibraryConfig c;
              c.coarse_iterations = coarse_iterations;
              c.coarse_points = coarse_points;
@@ -246,6 +247,7 @@ point-to-plane ICP, then a truncated RMS score [m]).)doc")
              c.field_cell = field_cell;
              c.score_gate = score_gate;
              c.unknown_score = unknown_score;
+             c.threads = threads;
              return reg::ObjectLibrary<double>(c);
            }),
            py::kw_only(), py::arg("coarse_iterations") = 10, py::arg("coarse_points") = 64,
@@ -253,7 +255,7 @@ point-to-plane ICP, then a truncated RMS score [m]).)doc")
            py::arg("pca_starts") = true, py::arg("rotation_starts") = 24,
            py::arg("refine_best") = 2, py::arg("exact_models") = 3,
            py::arg("hopeless_factor") = 3.0, py::arg("field_cell") = 2e-3,
-           py::arg("score_gate") = 0.01, py::arg("unknown_score") = 3e-3)
+           py::arg("score_gate") = 0.01, py::arg("unknown_score") = 3e-3, py::arg("threads") = 0)
       .def(
           "add",
           [](reg::ObjectLibrary<double>& lib, std::string name, const ArrayD& points,

@@ -78,8 +78,9 @@ class ModelMatch:
 
 class ObjectLibrary:
     """Named object models; recognize() ranks them by how well each explains a cloud (multi-start
-point-to-plane ICP, then a truncated RMS score [m])."""
-    def __init__(self, *, coarse_iterations: int = 10, coarse_points: int = 64, refine_points: int = 512, coarse_trim: float = 0.0, pca_starts: bool = True, rotation_starts: int = 24, refine_best: int = 2, exact_models: int = 3, hopeless_factor: float = 3.0, field_cell: float = 0.002, score_gate: float = 0.01, unknown_score: float = 0.003) -> None: ...
+point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its starts out over
+`threads` threads (0: every core); the answer does not depend on the number."""
+    def __init__(self, *, coarse_iterations: int = 10, coarse_points: int = 64, refine_points: int = 512, coarse_trim: float = 0.0, pca_starts: bool = True, rotation_starts: int = 24, refine_best: int = 2, exact_models: int = 3, hopeless_factor: float = 3.0, field_cell: float = 0.002, score_gate: float = 0.01, unknown_score: float = 0.003, threads: int = 0) -> None: ...
     def __len__(self) -> int: ...
     def add(self, name: str, points: numpy.typing.NDArray[numpy.float64], normals: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, *, normal_neighbors: int = 12) -> None: """Adds a model: (N, 3) points [m], optional normals."""
     @property

@@ -74,3 +74,15 @@ def test_object_library_ranks_the_true_object_first():
         t = rec.ranking[0].transform
         back = seen @ t[:3, :3].T + t[:3, 3]
         assert np.abs(shape.signed_distance(back)).max() < 2e-3
+    # One thread or three: the same ranking, scores and poses, to the bit.
+    single = registration.ObjectLibrary(threads=1)
+    triple = registration.ObjectLibrary(threads=3)
+    for name, shape in shapes.items():
+        single.add(name, surface(shape, 4000))
+        triple.add(name, surface(shape, 4000))
+    seen = surface(shapes["cone"], 600, seed=7) @ truth[:3, :3].T + truth[:3, 3]
+    a, b = single.recognize(seen), triple.recognize(seen)
+    assert [m.name for m in a.ranking] == [m.name for m in b.ranking]
+    assert [m.score for m in a.ranking] == [m.score for m in b.ranking]
+    for ma, mb in zip(a.ranking, b.ranking):
+        assert np.array_equal(ma.transform, mb.transform)
