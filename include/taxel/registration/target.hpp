@@ -97,10 +97,13 @@ class Target {
   /// The kd-tree over the same points.
   [[nodiscard]] const index::KdTree<S>& kdtree() const noexcept { return tree_; }
 
-  /// The closest point within distance r of q (ties by id), if any: exact. The grid serves
-  /// searches up to three cells from q; beyond, the kd-tree, whose search the closest-point
-  /// field (when built) bounds from above (the stored point's distance to q) and from below
-  /// (its distance to the cell centre minus half the cell diagonal: far queries end at once).
+  /// The closest point within distance r of q (ties by id), if any: exact. With a
+  /// closest-point field, the point stored for q's field cell bounds the answer from below
+  /// (its distance to the cell centre minus half the cell diagonal: far queries end at once)
+  /// and from above (its distance to q): within a grid cell of q the grid reads only the cells
+  /// of that ball, farther the kd-tree searches no farther. Without a field (or when the
+  /// stored point lies beyond r) the grid serves searches up to three cells from q and the
+  /// kd-tree those beyond.
   [[nodiscard]] std::optional<index::Neighbor<S>> nearest_within(const Vec3<S>& q, S r) const {
     if (!(r >= S(0)) || !q.allFinite()) return std::nullopt;
     if (const auto cell = field_cell_of(q)) {
