@@ -70,6 +70,9 @@ struct ContactOptions {
   ContactMode mode = ContactMode::per_tactel;  ///< a contact per active tactel, or per pad
   bool local_normals = true;      ///< normals from the depth map (false: the pad normal)
   bool correct_censoring = true;  ///< remove the truncation bias of near-threshold readings
+  /// Evaluate that correction at the depth a pad-wide quadric predicts rather than at the
+  /// reading (unbiased at the rim of a contact; about twice the cost per active tactel).
+  bool refine_censoring = true;
   /// Angular standard deviation [rad] of a normal slope that the depth map cannot measure
   /// (too few active neighbours); > 0.
   double fallback_normal_sigma = 0.15;
@@ -118,14 +121,15 @@ class ContactExtractor {
     }
     depth_.assign(static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols, kNone);
     var_.assign(depth_.size(), 0.0);
+    plug_in_.assign(depth_.size(), 0.0);
     // lambda(a) and lambda''(a) on a grid of a (lambda' = lambda (lambda - a),
     // lambda'' = lambda' (lambda - a) + lambda (lambda' - 1)), for the refined correction.
     for (int i = 0; i < kTable; ++i) {
       const double a = kTableLow + i / kTableScale;
       const double lam = truncation_bias(-a, 0.0, 1.0);
       const double l1 = lam * (lam - a);
-      lambda_[i] = lam;
-      lambda2_[i] = l1 * (lam - a) + lam * (l1 - 1.0);
+      lambda_[i][0] = lam;
+      lambda_[i][1] = l1 * (lam - a) + lam * (l1 - 1.0);
     }
   }
 
@@ -157,6 +161,7 @@ class ContactExtractor {
         if (k >= model_.threshold && k < saturated) {
           const double b = bias_[static_cast<std::size_t>(k)];
           d = k * dq - b;
+          plug_in_[static_cast<std::size_t>(r) * g.cols + c] = b;
           var_[static_cast<std::size_t>(r) * g.cols + c] = vd + b * b;
           ++active;
         } else {
@@ -165,7 +170,7 @@ class ContactExtractor {
       }
     }
     if (active == 0) return 0;
-    if (options_.correct_censoring) refine_censoring(counts);
+    if (options_.correct_censoring && options_.refine_censoring) refine_censoring();
     return options_.mode == ContactMode::per_tactel ? per_tactel(counts, T_world_pad, time, out)
                                                     : per_pad(counts, T_world_pad, time, out);
   }
@@ -285,83 +290,87 @@ class ContactExtractor {
   // Leaves the plug-in depths when fewer than six tactels are active, the quadric is not
   // determined or it does not fit.
   template <class = void>
-  void refine_censoring(const PadMatrix& counts) {
+  void refine_censoring() {
     const PadGeometry& g = model_.geometry;
     const double dq = model_.depth_per_count();
     const double sigma = model_.sigma_normal;
     if (!(sigma > 0)) return;
     const double t = (model_.threshold - 0.5) * dq;
     const double x0 = 0.5 * (g.cols - 1), y0 = 0.5 * (g.rows - 1);
+    // Pass 0's normal equations, on the plug-in depths.
     active_.clear();
-    double ata[36] = {};
+    double ata[36] = {}, sol[6] = {};
     for (int r = 0; r < g.rows; ++r) {
       for (int c = 0; c < g.cols; ++c) {
         const std::size_t i = static_cast<std::size_t>(r) * g.cols + c;
-        if (depth_[i] == kNone) continue;
+        const double d = depth_[i];
+        if (d == kNone) continue;
         const double X = c - x0, Y = r - y0;
         const double row[6] = {1.0, X, Y, X * X, X * Y, Y * Y};
         for (int a = 0; a < 6; ++a) {
+          sol[a] += row[a] * d;
           for (int b = 0; b <= a; ++b) ata[a * 6 + b] += row[a] * row[b];
         }
-        active_.push_back({i, X, Y, counts(r, c) * dq, 0.0});
+        active_.push_back({i, X, Y, d + plug_in_[i], 0.0});
       }
     }
     const double n = static_cast<double>(active_.size());
-    if (n < 6 || !detail_cholesky(ata, 6)) return;
+    double inv_diag[6];
+    if (n < 6 || !detail_cholesky(ata, 6, inv_diag)) return;
+    detail_solve(ata, 6, inv_diag, sol);
     const double vd = depth_variance();
-    const double half_v_over_sigma = 0.5 * vd / sigma;
-    for (Active& e : active_) {  // leverage: |L^-1 row|^2
+    const double half_v_over_sigma = 0.5 * vd / sigma, inv_sigma = 1.0 / sigma;
+    // The correction at fitted depth f: d = measured - sigma lambda(a) + jensen lambda''(a),
+    // a = (t - f) / sigma, by linear interpolation in the tables (a clamped to their range; f
+    // itself is not clamped at 0: the fit's noise is symmetric, a clamp would bias it), and
+    // the variance of the corrected depth: the truncated normal's, sigma^2 (1 - lambda'),
+    // plus the fit's share through the correction's slope lambda'.
+    const auto correct = [&](const Active& e, double f) {
+      const double a = (t - f) * inv_sigma;
+      const double u = std::clamp((a - kTableLow) * kTableScale, 0.0, double(kTable - 1) - 1e-9);
+      const int k = static_cast<int>(u);
+      const double w = u - k;
+      const double lam = lambda_[k][0] + w * (lambda_[k + 1][0] - lambda_[k][0]);
+      const double l2 = lambda_[k][1] + w * (lambda_[k + 1][1] - lambda_[k][1]);
+      const double l1 = lam * (lam - a);
+      depth_[e.index] = e.measured - sigma * lam + e.jensen * l2;
+      var_[e.index] = vd * (1.0 - l1) + l1 * l1 * e.jensen * 2.0 * sigma;
+    };
+    const auto fitted = [](const double* q, const Active& e) {
+      return q[0] + e.x * (q[1] + q[3] * e.x + q[4] * e.y) + e.y * (q[2] + q[5] * e.y);
+    };
+    // Pass 0: leverages, residuals, corrections at the first fit, pass 1's right-hand side.
+    double rss = 0, sol1[6] = {};
+    for (Active& e : active_) {
       double y[6] = {1.0, e.x, e.y, e.x * e.x, e.x * e.y, e.y * e.y};
       double h = 0;
-      for (int a = 0; a < 6; ++a) {
+      for (int a = 0; a < 6; ++a) {  // leverage |L^-1 row|^2
         for (int b = 0; b < a; ++b) y[a] -= ata[a * 6 + b] * y[b];
-        y[a] /= ata[a * 6 + a];
+        y[a] *= inv_diag[a];
         h += y[a] * y[a];
       }
       e.jensen = h * half_v_over_sigma;
+      const double f = fitted(sol, e);
+      const double res = depth_[e.index] - f;
+      rss += res * res;
+      correct(e, f);
+      const double d = depth_[e.index];
+      const double row[6] = {1.0, e.x, e.y, e.x * e.x, e.x * e.y, e.y * e.y};
+      for (int a = 0; a < 6; ++a) sol1[a] += row[a] * d;
     }
-    const double inv_sigma = 1.0 / sigma;
-    for (int pass = 0; pass < 2; ++pass) {
-      double sol[6] = {};
+    // A chi-square test of the residuals, at about 3 standard deviations of their sum.
+    if (!(rss <= vd * (n - 6 + 3 * std::sqrt(2 * (n - 6))))) {
+      // Not a quadric (an edge, a corner): back to the plug-in depths.
       for (const Active& e : active_) {
-        const double d = depth_[e.index];
-        const double row[6] = {1.0, e.x, e.y, e.x * e.x, e.x * e.y, e.y * e.y};
-        for (int a = 0; a < 6; ++a) sol[a] += row[a] * d;
+        const double b = plug_in_[e.index];
+        depth_[e.index] = e.measured - b;
+        var_[e.index] = vd + b * b;
       }
-      detail_solve(ata, 6, sol);
-      double rss = 0;
-      for (const Active& e : active_) {
-        double& d = depth_[e.index];
-        const double f = sol[0] + sol[1] * e.x + sol[2] * e.y + sol[3] * e.x * e.x +
-                         sol[4] * e.x * e.y + sol[5] * e.y * e.y;
-        rss += (d - f) * (d - f);
-        // Linear interpolation in the tables, a clamped to their range.
-        // (f is not clamped at 0: the fit's noise is symmetric, a clamp would bias it.)
-        double u = ((t - f) * inv_sigma - kTableLow) * kTableScale;
-        u = std::clamp(u, 0.0, double(kTable - 1) - 1e-9);
-        const int k = static_cast<int>(u);
-        const double w = u - k;
-        const double lam = lambda_[k] + w * (lambda_[k + 1] - lambda_[k]);
-        const double l2 = lambda2_[k] + w * (lambda2_[k + 1] - lambda2_[k]);
-        d = e.measured - sigma * lam + e.jensen * l2;
-        // The variance of the corrected depth: the truncated normal's, sigma^2 (1 - lambda'),
-        // plus the fit's share through the correction's slope lambda'.
-        const double l1 = lam * (lam - (t - f) * inv_sigma);
-        var_[e.index] = vd * (1.0 - l1) + l1 * l1 * e.jensen * 2.0 * sigma;
-      }
-      // A chi-square test of the residuals at about 3 standard deviations of their sum.
-      if (pass == 0 && !(rss <= vd * (n - 6 + 3 * std::sqrt(2 * (n - 6))))) {
-        // Not a quadric (an edge, a corner): back to the plug-in depths.
-        for (const Active& e : active_) {
-          const int k =
-              counts(static_cast<int>(e.index / g.cols), static_cast<int>(e.index % g.cols));
-          const double b = bias_[static_cast<std::size_t>(k)];
-          depth_[e.index] = e.measured - b;
-          var_[e.index] = vd + b * b;
-        }
-        return;
-      }
+      return;
     }
+    // Pass 1: the corrections at the refit.
+    detail_solve(ata, 6, inv_diag, sol1);
+    for (const Active& e : active_) correct(e, fitted(sol1, e));
   }
 
   double q2() const { return model_.geometry.pitch * model_.geometry.pitch / 12.0; }
@@ -408,12 +417,13 @@ class ContactExtractor {
         }
       }
     }
-    if (!detail_cholesky(ata, 6)) return per_tactel(counts, T, time, out);
-    detail_solve(ata, 6, sol);
+    double inv_l[6];
+    if (!detail_cholesky(ata, 6, inv_l)) return per_tactel(counts, T, time, out);
+    detail_solve(ata, 6, inv_l, sol);
     for (int i = 0; i < 3; ++i) {
       double e[6] = {};
       e[i] = 1.0;
-      detail_solve(ata, 6, e);
+      detail_solve(ata, 6, inv_l, e);
       inv_diag[i] = e[i];
     }
     double gx = 0, gy = 0, slope_var = 0.0;
@@ -428,40 +438,43 @@ class ContactExtractor {
     return 1;
   }
 
-  // In-place Cholesky factor (lower triangle, row stride 6) of the leading m x m block; false
-  // when a pivot is not positive relative to its diagonal entry.
-  static bool detail_cholesky(double* a, int m) {
+  // In-place Cholesky factor (lower triangle, row stride 6) of the leading m x m block, and the
+  // reciprocals of its diagonal; false when a pivot is not positive relative to its diagonal
+  // entry.
+  static bool detail_cholesky(double* a, int m, double* inv_diag) {
     for (int j = 0; j < m; ++j) {
       double djj = a[j * 6 + j];
       for (int k = 0; k < j; ++k) djj -= a[j * 6 + k] * a[j * 6 + k];
       if (!(djj > 1e-10 * a[j * 6 + j])) return false;
       const double ljj = std::sqrt(djj);
       a[j * 6 + j] = ljj;
+      inv_diag[j] = 1.0 / ljj;
       for (int i = j + 1; i < m; ++i) {
         double v = a[i * 6 + j];
         for (int k = 0; k < j; ++k) v -= a[i * 6 + k] * a[j * 6 + k];
-        a[i * 6 + j] = v / ljj;
+        a[i * 6 + j] = v * inv_diag[j];
       }
     }
     return true;
   }
   // Solves L L' x = b in place with the factor of detail_cholesky.
-  static void detail_solve(const double* l, int m, double* b) {
+  static void detail_solve(const double* l, int m, const double* inv_diag, double* b) {
     for (int i = 0; i < m; ++i) {
       for (int k = 0; k < i; ++k) b[i] -= l[i * 6 + k] * b[k];
-      b[i] /= l[i * 6 + i];
+      b[i] *= inv_diag[i];
     }
     for (int i = m - 1; i >= 0; --i) {
       for (int k = i + 1; k < m; ++k) b[i] -= l[k * 6 + i] * b[k];
-      b[i] /= l[i * 6 + i];
+      b[i] *= inv_diag[i];
     }
   }
 
   SensorModel model_;
   ContactOptions options_;
-  std::vector<double> bias_;   // truncation bias by reading count [m]
-  std::vector<double> depth_;  // corrected depth per tactel [m]; kNone when not active
-  std::vector<double> var_;    // its variance [m^2], for active tactels
+  std::vector<double> bias_;     // truncation bias by reading count [m]
+  std::vector<double> depth_;    // corrected depth per tactel [m]; kNone when not active
+  std::vector<double> var_;      // its variance [m^2], for active tactels
+  std::vector<double> plug_in_;  // the plug-in correction [m], for active tactels
   // The refined correction's workspace: an active tactel, its pad coordinates (pitch units from
   // the pad centre), measured depth [m] and Jensen factor h v / (2 sigma) [m].
   struct Active {
@@ -472,7 +485,7 @@ class ContactExtractor {
   // lambda and lambda'' tabulated at a = kTableLow + i / kTableScale.
   static constexpr int kTable = 641;  // a in [-12, 8]
   static constexpr double kTableLow = -12.0, kTableScale = 32.0;
-  double lambda_[kTable] = {}, lambda2_[kTable] = {};
+  double lambda_[kTable][2] = {};
 };
 
 }  // namespace taxel::sensor
