@@ -319,23 +319,28 @@ How readings become contacts: `mode` 'per_tactel' (a contact per active tactel) 
 (one per pad and frame, from a quadric fitted to its depth map; one per tactel in a frame with
 fewer than six active); `local_normals` (normals from the pad's depth map, else the pad normal); `correct_censoring`
 (remove the bias of readings that barely passed the noise floor); `fallback_normal_sigma`
-[rad], the slope uncertainty where the depth map cannot measure it.)doc")
+[rad], the slope uncertainty where the depth map cannot measure it; `refine_censoring` (evaluate
+that correction at the depth a quadric fitted to the pad predicts, unbiased at the rim of a
+contact; False: at the reading itself, about half the cost).)doc")
       .def(py::init([](const std::string& mode, bool local_normals, bool correct_censoring,
-                       double fallback_normal_sigma) {
+                       double fallback_normal_sigma, bool refine_censoring) {
              sensor::ContactOptions o;
              o.mode = enum_from(mode, kModes, "mode");
              o.local_normals = local_normals;
              o.correct_censoring = correct_censoring;
              o.fallback_normal_sigma = fallback_normal_sigma;
+             o.refine_censoring = refine_censoring;
              o.validate();
              return o;
            }),
            py::arg("mode") = "per_tactel", py::arg("local_normals") = true,
-           py::arg("correct_censoring") = true, py::arg("fallback_normal_sigma") = 0.15)
+           py::arg("correct_censoring") = true, py::arg("fallback_normal_sigma") = 0.15,
+           py::arg("refine_censoring") = true)
       .def_property_readonly(
           "mode", [](const sensor::ContactOptions& o) { return enum_name(o.mode, kModes); })
       .def_readonly("local_normals", &sensor::ContactOptions::local_normals)
       .def_readonly("correct_censoring", &sensor::ContactOptions::correct_censoring)
+      .def_readonly("refine_censoring", &sensor::ContactOptions::refine_censoring)
       .def_readonly("fallback_normal_sigma", &sensor::ContactOptions::fallback_normal_sigma);
 
   s.def("contacts_from_readings", &readings_to_contacts, py::arg("readings"), py::arg("poses"),

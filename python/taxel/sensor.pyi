@@ -21,8 +21,10 @@ class ContactOptions:
 (one per pad and frame, from a quadric fitted to its depth map; one per tactel in a frame with
 fewer than six active); `local_normals` (normals from the pad's depth map, else the pad normal); `correct_censoring`
 (remove the bias of readings that barely passed the noise floor); `fallback_normal_sigma`
-[rad], the slope uncertainty where the depth map cannot measure it."""
-    def __init__(self, mode: str = 'per_tactel', local_normals: bool = True, correct_censoring: bool = True, fallback_normal_sigma: float = 0.15) -> None: ...
+[rad], the slope uncertainty where the depth map cannot measure it; `refine_censoring` (evaluate
+that correction at the depth a quadric fitted to the pad predicts, unbiased at the rim of a
+contact; False: at the reading itself, about half the cost)."""
+    def __init__(self, mode: str = 'per_tactel', local_normals: bool = True, correct_censoring: bool = True, fallback_normal_sigma: float = 0.15, refine_censoring: bool = True) -> None: ...
     @property
     def correct_censoring(self) -> bool: ...
     @property
@@ -31,6 +33,8 @@ fewer than six active); `local_normals` (normals from the pad's depth map, else 
     def local_normals(self) -> bool: ...
     @property
     def mode(self) -> str: ...
+    @property
+    def refine_censoring(self) -> bool: ...
 
 
 class SensorModel:

@@ -194,6 +194,26 @@ def test_readings_errors():
         sensor.SensorModel(threshold=0)
 
 
+def test_refined_and_plug_in_censoring_corrections():
+    # A pad pressed flat: every tactel reads 1000 of 4095 (3 mm full scale, threshold 8).
+    model = sensor.SensorModel()
+    readings = np.full((1, 1, 14, 6), 1000, dtype=np.uint16)
+    poses = np.eye(4).reshape(1, 1, 4, 4)
+    dq = 3e-3 / 4095
+    measured, threshold = 1000 * dq, 7.5 * dq
+    plug = sensor.ContactOptions(refine_censoring=False)
+    assert sensor.ContactOptions().refine_censoring and not plug.refine_censoring
+    flat = sensor.contacts_from_readings(readings, poses, options=plug).positions[:, 2]
+    # At the reading: d = m - sigma * lambda((t - m) / sigma).
+    want = measured - sensor.truncation_bias(measured, threshold, model.sigma_normal)
+    np.testing.assert_allclose(-flat, want, rtol=1e-12)
+    # Refined: at the fitted depth, here the corrected depth itself, plus a second-order term
+    # of a few micrometres; never shallower than the plug-in value.
+    refined = -sensor.contacts_from_readings(readings, poses).positions[:, 2]
+    assert np.all(refined >= want - 1e-6) and np.all(refined <= want + 4e-6)
+    assert np.any(refined != want)
+
+
 def test_truncation_bias_closed_form():
     # At the threshold, the bias of a surviving reading is sigma * phi(0) / (1 - Phi(0)).
     assert sensor.truncation_bias(1e-3, 1e-3, 3e-4) == pytest.approx(3e-4 * np.sqrt(2 / np.pi))
