@@ -15,16 +15,19 @@
 //     above the threshold and its square is added to the depth variance.
 //     The plug-in value is itself biased where it matters most: a tactel at the rim of the
 //     contact (true depth near 0) that survives reads high, so lambda at its reading is too
-//     small (E[d - true] = +0.07 mm at a true depth below 0.2 mm, sigma 0.3 mm). When six or
-//     more tactels are active and a quadric in the pad plane fits their plug-in depths (a
-//     chi-square test of the residuals, sum below v (n - 6 + 3 sqrt(2 (n - 6))): not across an
-//     edge), the correction is evaluated instead at
-//     the depth f the quadric predicts for the tactel, which the tactel's own noise barely
-//     moves: d = m - sigma * lambda(a) + (h v / 2) lambda''(a) / sigma, a = (t - f) / sigma, the
-//     second term removing the bias of a curved correction evaluated at a noisy f (Jensen; v
-//     the depth variance, h the tactel's leverage in the fit, so h v is f's variance). The
-//     quadric is refitted once to the corrected depths and the correction evaluated again
-//     (a second pass; further passes drift, feeding each fit's error back through lambda).
+//     small (E[d - true] = +0.07 mm at a true depth below 0.2 mm, sigma 0.3 mm). When more
+//     than six tactels are active and a quadric in the pad plane fits their plug-in depths (a
+//     chi-square test: the residuals' sum of squares below v (n - 6 + 3 sqrt(2 (n - 6))), so
+//     not across an edge), the correction is evaluated instead at the depth f the quadric
+//     predicts for the tactel, which the tactel's own noise barely moves:
+//       d = m - sigma * lambda(a) + (h v / 2) lambda''(a) / sigma,   a = (t - f) / sigma,
+//     the second term removing the bias of a curved correction evaluated at a noisy f (Jensen;
+//     v the depth variance sigma^2 + dq^2 / 12 with dq the depth of one count, h the tactel's
+//     leverage in the fit, so h v is f's variance). The quadric is refitted once to the corrected
+//     depths and the correction evaluated again (a second pass; further passes drift, feeding each
+//     fit's error back through lambda). The corrected depth's variance is then the truncated
+//     normal's, v (1 - lambda'(a)), plus the fit's share, lambda'(a)^2 h v; with the plug-in
+//     correction it is v + c^2 (c the correction).
 //  2. Normal. A plane d(x, y) = a + g . (x, y) is fitted by least squares to the corrected
 //     depths of the tactel and its active 8-neighbours; the surface in the pad frame is
 //     z = -d(x, y), so its outward normal is -(g_x, g_y, 1) / |(g_x, g_y, 1)|. Where the active
@@ -33,9 +36,9 @@
 //     fallback_normal_sigma^2.
 //  3. Covariance. Tight along that normal, wide across it:
 //       across:  s_t^2 = pitch^2 / 12 + sigma_position^2 + |xy|^2 sigma_tilt^2 / 6
-//       along:   s_n^2 = sigma_normal^2 + dq^2 / 12 + c^2 + sigma_position^2
+//       along:   s_n^2 = var d + sigma_position^2
 //                        + |xy|^2 sigma_tilt^2 / 3 + (pitch^2 / 12) (var g_x + var g_y)
-//     (dq the depth of one count, c the censoring correction, |xy| the tactel's lever arm from
+//     (var d the corrected depth's variance of step 1, |xy| the tactel's lever arm from
 //     the pad origin; the last term is the normal's own uncertainty: a plane tilted by beta
 //     misstates the height by beta * u over a sideways offset u, and u spreads over the
 //     tactel's footprint). The slope variances are the least-squares ones,
@@ -290,7 +293,7 @@ class ContactExtractor {
 
   // The refined censoring correction (the model above, step 1): quadric fit of the plug-in
   // depths, the correction evaluated at the fitted depth with its Jensen term, refitted once.
-  // Leaves the plug-in depths when fewer than six tactels are active, the quadric is not
+  // Leaves the plug-in depths when at most six tactels are active, the quadric is not
   // determined or it does not fit.
   template <class = void>
   void refine_censoring() {
@@ -319,7 +322,7 @@ class ContactExtractor {
     }
     const double n = static_cast<double>(active_.size());
     double inv_diag[6];
-    if (n < 6 || !detail_cholesky(ata, 6, inv_diag)) return;
+    if (n < 7 || !detail_cholesky(ata, 6, inv_diag)) return;
     detail_solve(ata, 6, inv_diag, sol);
     const double vd = depth_variance();
     const double half_v_over_sigma = 0.5 * vd / sigma, inv_sigma = 1.0 / sigma;
