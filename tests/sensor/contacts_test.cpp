@@ -192,13 +192,13 @@ TEST_CASE("readings to contacts: the censoring correction removes the threshold'
   }
   REQUIRE(n > 50000);
   REQUIRE(n_rim > 5000);
-  CHECK(err_plain / double(n) > 0.02e-3);        // about +0.046 mm over all tactels
-  CHECK(std::abs(err / double(n)) < 0.005e-3);   // about +0.001 mm
-  CHECK(rim_plain / double(n_rim) > 0.15e-3);    // about +0.18 mm at the rim
-  CHECK(rim_plug_in / double(n_rim) > 0.05e-3);  // about +0.064 mm: the plug-in falls short
-  CHECK(std::abs(rim / double(n_rim)) < 0.015e-3);
-  CHECK(rim_option ==
-        Approx(rim_plug_in).epsilon(1e-9));  // refine_censoring = false  // about +0.0003 mm
+  CHECK(err_plain / double(n) > 0.02e-3);           // about +0.046 mm over all tactels
+  CHECK(std::abs(err / double(n)) < 0.005e-3);      // about +0.001 mm
+  CHECK(rim_plain / double(n_rim) > 0.15e-3);       // about +0.18 mm at the rim
+  CHECK(rim_plug_in / double(n_rim) > 0.05e-3);     // about +0.064 mm: the plug-in falls short
+  CHECK(std::abs(rim / double(n_rim)) < 0.015e-3);  // about +0.0003 mm
+  // refine_censoring = false: the plug-in correction.
+  CHECK(rim_option == Approx(rim_plug_in).epsilon(1e-9));
   CHECK(tsn::truncation_bias(10e-3, 0.0, 0.3e-3) == 0.0);
   CHECK(tsn::truncation_bias(0.0, 0.0, 0.3e-3) == Approx(0.3e-3 * std::sqrt(2 / M_PI)));
 }
