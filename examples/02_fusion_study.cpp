@@ -9,9 +9,13 @@
 // Kalman and Average equal, as the theory says. Writes every cloud as PLY and a plot of RMS error
 // against the number of contacts.
 //   ./02_fusion_study [--quick] [--out DIR]
+#include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -24,6 +28,16 @@ namespace {
 
 using namespace taxel;
 namespace tf = taxel::fusion;
+
+// printf into a string: each job writes its own lines, printed in a fixed order afterwards.
+[[gnu::format(printf, 2, 3)]] void appendf(std::string& to, const char* fmt, ...) {
+  char buf[512];
+  va_list ap;
+  va_start(ap, fmt);
+  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  if (n > 0) to.append(buf, std::min<std::size_t>(static_cast<std::size_t>(n), sizeof buf - 1));
+}
 
 struct Row {
   sim::ReconstructionMetrics m;
@@ -80,14 +94,13 @@ struct Study {
   std::vector<double> average3, kalman3, surfel3;    // the same over the confident points
 };
 
+// The stream of a study: several slides from random starts, so the cloud covers much of the
+// object. With two pads (`mixed`), the fingertip and the palm pad explore at the same time:
+// each makes its own slides, and their streams are interleaved in blocks of 200 contacts, so
+// that every prefix of the stream (the error curve's checkpoints) holds both in equal parts.
 template <class Shape>
-void study(const char* name, const Shape& shape, std::size_t n, const sim::SlidingConfig& noise,
-           const std::filesystem::path& out, Study* curve, bool print_header, bool mixed,
-           double radius) {
-  // Several slides from random starts, so the cloud covers much of the object. With two pads
-  // (`mixed`), the fingertip and the palm pad explore at the same time: each makes its own
-  // slides, and their streams are interleaved in blocks of 200 contacts, so that every prefix
-  // of the stream (the error curve's checkpoints) holds both in equal parts.
+std::vector<Contact<double>> study_stream(const Shape& shape, std::size_t n,
+                                          const sim::SlidingConfig& noise, bool mixed) {
   const auto slides = [&](std::size_t count, bool palm, std::uint64_t salt) {
     std::vector<Contact<double>> part;
     for (std::uint64_t s = 0; part.size() < count; ++s) {
@@ -103,29 +116,36 @@ void study(const char* name, const Shape& shape, std::size_t n, const sim::Slidi
     }
     return part;
   };
+  if (!mixed) return slides(n, false, 0);
   std::vector<Contact<double>> contacts;
-  if (!mixed) {
-    contacts = slides(n, false, 0);
-  } else {
-    const auto tip = slides(n / 2, false, 0);
-    const auto palm = slides(n - n / 2, true, 1);
-    constexpr std::size_t kBlock = 200;
-    for (std::size_t b = 0; contacts.size() < n; b += kBlock) {
-      for (const auto* stream : {&tip, &palm}) {
-        const std::size_t end = std::min(b + kBlock, stream->size());
-        if (b < end) contacts.insert(contacts.end(), stream->begin() + b, stream->begin() + end);
-      }
+  const auto tip = slides(n / 2, false, 0);
+  const auto palm = slides(n - n / 2, true, 1);
+  constexpr std::size_t kBlock = 200;
+  for (std::size_t b = 0; contacts.size() < n; b += kBlock) {
+    for (const auto* stream : {&tip, &palm}) {
+      const std::size_t end = std::min(b + kBlock, stream->size());
+      if (b < end) contacts.insert(contacts.end(), stream->begin() + b, stream->begin() + end);
     }
   }
-  if (print_header) {
-    std::printf("%-26s %-8s %7s %7s %8s %7s %7s %7s %6s | %6s %7s\n", "shape", "policy", "points",
-                "compact", "signed mm", "mean mm", "rms mm", "max mm", "cover", "n>=5", "rms mm");
-  }
+  return contacts;
+}
+
+const char* const kStudyHeader =
+    "shape                      policy    points compact signed mm mean mm  rms mm  max mm  "
+    "cover |   n>=5  rms mm\n";
+
+// One shape's table rows: the four policies on the whole stream; their clouds go to `out`.
+template <class Shape>
+std::string study(const char* name, const Shape& shape, std::size_t n,
+                  const sim::SlidingConfig& noise, const std::filesystem::path& out, bool mixed,
+                  double radius) {
+  const std::vector<Contact<double>> contacts = study_stream(shape, n, noise, mixed);
+  std::string text;
   const auto line = [&](const char* policy, const Row& r) {
-    std::printf("%-26s %-8s %7zu %6.1fx %+8.3f %7.3f %7.3f %7.2f %5.1f%% | %6zu %7.3f\n", name,
-                policy, r.m.points, r.m.compaction, 1e3 * r.m.error.signed_mean,
-                1e3 * r.m.error.mean, 1e3 * r.m.error.rms, 1e3 * r.m.error.max,
-                100.0 * r.m.coverage, r.confirmed_points, 1e3 * r.confirmed.rms);
+    appendf(text, "%-26s %-8s %7zu %6.1fx %+8.3f %7.3f %7.3f %7.2f %5.1f%% | %6zu %7.3f\n", name,
+            policy, r.m.points, r.m.compaction, 1e3 * r.m.error.signed_mean, 1e3 * r.m.error.mean,
+            1e3 * r.m.error.rms, 1e3 * r.m.error.max, 100.0 * r.m.coverage, r.confirmed_points,
+            1e3 * r.confirmed.rms);
   };
   const std::string stem = out.empty() ? std::string() : (out / safe(name)).string();
   const auto file = [&](const char* policy) {
@@ -136,23 +156,24 @@ void study(const char* name, const Shape& shape, std::size_t n, const sim::Slidi
   line("average", fuse<tf::Average<double>>(shape, contacts, n, file("average"), radius));
   line("kalman", fuse<tf::Kalman<double>>(shape, contacts, n, file("kalman"), radius));
   line("surfel", fuse<tf::Surfel<double>>(shape, contacts, n, file("surfel"), radius));
-  if (curve != nullptr) {
-    for (std::size_t k = n / 64; k <= n; k *= 2) {
-      curve->contacts.push_back(static_cast<double>(k));
-      curve->raw.push_back(1e3 * fuse<tf::Raw<double>>(shape, contacts, k, {}, radius).m.error.rms);
-      const Row a = fuse<tf::Average<double>>(shape, contacts, k, {}, radius);
-      const Row kf = fuse<tf::Kalman<double>>(shape, contacts, k, {}, radius);
-      const Row sf = fuse<tf::Surfel<double>>(shape, contacts, k, {}, radius);
-      curve->average.push_back(1e3 * a.m.error.rms);
-      curve->kalman.push_back(1e3 * kf.m.error.rms);
-      curve->surfel.push_back(1e3 * sf.m.error.rms);
-      curve->average3.push_back(1e3 * a.supported.rms);
-      curve->kalman3.push_back(1e3 * kf.supported.rms);
-      curve->surfel3.push_back(1e3 * sf.supported.rms);
-      std::fprintf(stderr, "\r  error curve: %zu / %zu contacts ", k, n);
-    }
-    std::fputs("\r\033[K", stderr);
-  }
+  return text;
+}
+
+// One checkpoint of the error curve: every policy on the first `k` contacts of the stream.
+template <class Shape>
+void curve_point(const Shape& shape, const std::vector<Contact<double>>& contacts, std::size_t k,
+                 double radius, Study& curve, std::size_t at) {
+  curve.contacts[at] = static_cast<double>(k);
+  curve.raw[at] = 1e3 * fuse<tf::Raw<double>>(shape, contacts, k, {}, radius).m.error.rms;
+  const Row a = fuse<tf::Average<double>>(shape, contacts, k, {}, radius);
+  const Row kf = fuse<tf::Kalman<double>>(shape, contacts, k, {}, radius);
+  const Row sf = fuse<tf::Surfel<double>>(shape, contacts, k, {}, radius);
+  curve.average[at] = 1e3 * a.m.error.rms;
+  curve.kalman[at] = 1e3 * kf.m.error.rms;
+  curve.surfel[at] = 1e3 * sf.m.error.rms;
+  curve.average3[at] = 1e3 * a.supported.rms;
+  curve.kalman3[at] = 1e3 * kf.supported.rms;
+  curve.surfel3[at] = 1e3 * sf.supported.rms;
 }
 
 // The tactile pad model (sensor/, sim/sensor.hpp, sim/exploration.hpp): a DSA-like 14x6 pad
@@ -160,62 +181,65 @@ void study(const char* name, const Shape& shape, std::size_t n, const sim::Slidi
 // the three streams in turn, with contacts per active tactel or one per pad and frame. Three
 // seeds; the RMS and the signed (outside minus inside) error of each policy, and of the raw
 // contacts.
-struct PadTotals {
-  int shapes = 0, surfel_wins = 0;
+struct PadLine {
+  std::string text;
+  bool surfel_ahead = false;
 };
 
 template <class Shape>
-void pad_study(const char* name, const Shape& shape, bool quick, sim::ContactMode mode,
-               bool print_header, PadTotals& totals) {
-  if (print_header) {
-    std::printf("%-26s %-10s %4s %8s | %-15s | %-15s | %-15s | %-15s\n", "shape", "contacts",
-                "seed", "", "raw rms/signed", "average", "kalman", "surfel (default)");
-  }
+PadLine pad_study(const char* name, const Shape& shape, bool quick, sim::ContactMode mode,
+                  std::uint64_t seed) {
   constexpr double kGate = 4e-3;  // 4 sigma of the in-plane quantisation (0.98 mm)
   const int scale = quick ? 1 : 4;
-  for (const std::uint64_t seed : {11, 12, 13}) {
-    sim::ExplorationConfig cfg;
-    cfg.contacts.mode = mode;
-    cfg.seed = seed;
-    std::vector<Contact<double>> contacts;
-    const auto add = [&](const auto& ex) {
-      const auto part = ex.contacts();
-      contacts.insert(contacts.end(), part.begin(), part.end());
-    };
-    add(sim::explore_sliding(shape, cfg, {.slides = 2 * scale, .frames = 500}));
-    add(sim::explore_grasps(shape, cfg, {.grasps = 4 * scale}));
-    add(sim::explore_palpation(shape, cfg, {.touches = 20 * scale}));
-    const Row raw = fuse<tf::Raw<double>>(shape, contacts, contacts.size(), {}, kGate);
-    const Row avg = fuse<tf::Average<double>>(shape, contacts, contacts.size(), {}, kGate);
-    const Row kal = fuse<tf::Kalman<double>>(shape, contacts, contacts.size(), {}, kGate);
-    const Row sur = fuse<tf::Surfel<double>>(shape, contacts, contacts.size(), {}, kGate);
-    const auto cell = [](const Row& r) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%6.3f %+7.3f", 1e3 * r.m.error.rms,
-                    1e3 * r.m.error.signed_mean);
-      return std::string(buf);
-    };
-    std::printf("%-26s %-10s %4d %8zu | %s | %s | %s | %s%s\n", name,
-                mode == sim::ContactMode::per_tactel ? "per tactel" : "per pad", int(seed),
-                contacts.size(), cell(raw).c_str(), cell(avg).c_str(), cell(kal).c_str(),
-                cell(sur).c_str(), sur.m.error.rms < avg.m.error.rms ? "" : "  (average ahead)");
-    ++totals.shapes;
-    totals.surfel_wins += sur.m.error.rms < avg.m.error.rms ? 1 : 0;
-  }
+  sim::ExplorationConfig cfg;
+  cfg.contacts.mode = mode;
+  cfg.seed = seed;
+  std::vector<Contact<double>> contacts;
+  const auto add = [&](const auto& ex) {
+    const auto part = ex.contacts();
+    contacts.insert(contacts.end(), part.begin(), part.end());
+  };
+  add(sim::explore_sliding(shape, cfg, {.slides = 2 * scale, .frames = 500}));
+  add(sim::explore_grasps(shape, cfg, {.grasps = 4 * scale}));
+  add(sim::explore_palpation(shape, cfg, {.touches = 20 * scale}));
+  const Row raw = fuse<tf::Raw<double>>(shape, contacts, contacts.size(), {}, kGate);
+  const Row avg = fuse<tf::Average<double>>(shape, contacts, contacts.size(), {}, kGate);
+  const Row kal = fuse<tf::Kalman<double>>(shape, contacts, contacts.size(), {}, kGate);
+  const Row sur = fuse<tf::Surfel<double>>(shape, contacts, contacts.size(), {}, kGate);
+  const auto cell = [](const Row& r) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%6.3f %+7.3f", 1e3 * r.m.error.rms,
+                  1e3 * r.m.error.signed_mean);
+    return std::string(buf);
+  };
+  PadLine out;
+  out.surfel_ahead = sur.m.error.rms < avg.m.error.rms;
+  appendf(out.text, "%-26s %-10s %4d %8zu | %s | %s | %s | %s%s\n", name,
+          mode == sim::ContactMode::per_tactel ? "per tactel" : "per pad", int(seed),
+          contacts.size(), cell(raw).c_str(), cell(avg).c_str(), cell(kal).c_str(),
+          cell(sur).c_str(), out.surfel_ahead ? "" : "  (average ahead)");
+  return out;
 }
 
 constexpr const char* kUsage =
-    "usage: 02_fusion_study [--quick] [--out DIR]\n"
+    "usage: 02_fusion_study [--quick] [--out DIR] [--threads N]\n"
     "Raw vs Average vs Kalman vs Surfel fusion of simulated explorations of seven shapes: points,\n"
     "compaction, distance to the true surface, coverage; PLY clouds and an SVG plot of error\n"
-    "against contacts.\n";
+    "against contacts. --threads N runs the shapes, seeds and checkpoints on N threads (default\n"
+    "0: every core); the output is the same for any N.\n";
 
 }  // namespace
 
 int main(int argc, char** argv) try {
   taxel_cli::check_stdout_at_exit("02_fusion_study");
+  unsigned threads = 0;
   const taxel_cli::StudyOptions opt =
-      taxel_cli::parse_study_options("02_fusion_study", kUsage, "fusion-study", argc, argv);
+      taxel_cli::parse_study_options("02_fusion_study", kUsage, "fusion-study", argc, argv,
+                                     [&](std::string_view a, taxel_cli::Args& args) {
+                                       if (a != "--threads") return false;
+                                       threads = args.number<unsigned>(0, 4096);
+                                       return true;
+                                     });
   const bool quick = opt.quick;
   const std::filesystem::path out = opt.out;
   std::filesystem::create_directories(out);
@@ -242,62 +266,115 @@ int main(int argc, char** argv) try {
   aniso.sigma_tilt = 0.15;
   aniso.speed = 0.15;
   aniso.seed = 3;
+  constexpr double kRadius = 6e-3;          // the gate: about 4 sigma of the coarsest noise
+  sim::SlidingConfig iso;                   // the control: isotropic, constant noise (below)
+  iso.sigma_normal = tactel_sigma(3.4e-3);  // equal to the in-plane quantisation sigma
+  iso.sigma_tilt = 0.0;
+  iso.sigma_position = 0.0;
+  iso.speed = 0.15;
+  iso.seed = 3;
+
+  // Every table row and every checkpoint of the error curve is a job of its own, run on
+  // `threads` threads; each writes only its own slot, and the slots are printed in order, so
+  // the output does not depend on the thread count. The heaviest jobs go first.
+  std::vector<std::function<void()>> jobs;
+  Study curve;
+  std::vector<Contact<double>> curve_stream;  // sphere r40, both pads: the curve's stream
+  std::vector<std::size_t> checkpoints;
+  for (std::size_t k = n / 64; k <= n; k *= 2) checkpoints.push_back(k);
+  for (auto* v : {&curve.contacts, &curve.raw, &curve.average, &curve.kalman, &curve.surfel,
+                  &curve.average3, &curve.kalman3, &curve.surfel3}) {
+    v->assign(checkpoints.size(), 0.0);
+  }
+  curve_stream = study_stream(sim::Sphere(0.04), n, aniso, true);
+  for (std::size_t i = checkpoints.size(); i-- > 0;) {
+    jobs.emplace_back([&, i] {
+      curve_point(sim::Sphere(0.04), curve_stream, checkpoints[i], kRadius, curve, i);
+    });
+  }
+  std::vector<std::string> tables(8);
+  const auto table = [&](std::size_t slot, const char* name, const auto& shape,
+                         const sim::SlidingConfig& noise, bool mixed, bool write) {
+    jobs.emplace_back([&, slot, name, shape, mixed, write] {
+      tables[slot] =
+          study(name, shape, n, noise, write ? out : std::filesystem::path(), mixed, kRadius);
+    });
+  };
+  table(0, "sphere r40", sim::Sphere(0.04), aniso, true, true);
+  table(1, "cylinder r30 h100", sim::Cylinder(0.03, 0.05), aniso, true, true);
+  table(2, "box 80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02)), aniso, true, true);
+  table(3, "cone r30 h60", sim::Cone(0.03, 0.06), aniso, true, true);
+  table(4, "mesh icosphere r35 (PLY)", mesh, aniso, true, true);
+  table(5, "ellipsoid 100x70x50", sim::Ellipsoid(Vec3d(0.05, 0.035, 0.025)), aniso, true, true);
+  table(6, "torus R40 r15", sim::Torus(0.04, 0.015), aniso, true, true);
+  table(7, "sphere r40 isotropic", sim::Sphere(0.04), iso, false, false);
+  std::vector<PadLine> pads;
+  const auto pad = [&](const char* name, const auto& shape) {
+    for (const auto mode : {sim::ContactMode::per_tactel, sim::ContactMode::per_pad}) {
+      for (const std::uint64_t seed : {11, 12, 13}) {
+        const std::size_t slot = pads.size();
+        pads.emplace_back();
+        jobs.emplace_back([&, slot, name, shape, mode, seed] {
+          pads[slot] = pad_study(name, shape, quick, mode, seed);
+        });
+      }
+    }
+  };
+  pad("sphere r40", sim::Sphere(0.04));
+  pad("sphere r15", sim::Sphere(0.015));
+  pad("cylinder r30 h100", sim::Cylinder(0.03, 0.05));
+  pad("box 80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02)));
+  pad("cone r30 h60", sim::Cone(0.03, 0.06));
+  pad("mesh icosphere r35 (PLY)", mesh);
+  pad("ellipsoid 100x70x50", sim::Ellipsoid(Vec3d(0.05, 0.035, 0.025)));
+  pad("torus R40 r15", sim::Torus(0.04, 0.015));
+  std::atomic<std::size_t> done{0};
+  parallel_for(jobs.size(), threads, [&](std::size_t j) {
+    jobs[j]();
+    std::fprintf(stderr, "\r  %zu / %zu jobs ", done.fetch_add(1) + 1, jobs.size());
+  });
+  std::fputs("\r\033[K", stderr);
+
   std::printf(
       "Anisotropic pad noise: fingertip pad 0.3 mm along the normal / 0.98 mm across and palm "
       "pad 1.5 / 1.44 mm exploring at the same time, 0.15 rad tilt; %zu contacts per shape, "
       "association radius 6 mm\n",
       n);
-  Study curve;
-  constexpr double kRadius = 6e-3;  // the gate: about 4 sigma of the coarsest noise
-  study("sphere r40", sim::Sphere(0.04), n, aniso, out, &curve, true, true, kRadius);
-  study("cylinder r30 h100", sim::Cylinder(0.03, 0.05), n, aniso, out, nullptr, false, true,
-        kRadius);
-  study("box 80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02)), n, aniso, out, nullptr, false, true,
-        kRadius);
-  study("cone r30 h60", sim::Cone(0.03, 0.06), n, aniso, out, nullptr, false, true, kRadius);
-  study("mesh icosphere r35 (PLY)", mesh, n, aniso, out, nullptr, false, true, kRadius);
-  study("ellipsoid 100x70x50", sim::Ellipsoid(Vec3d(0.05, 0.035, 0.025)), n, aniso, out, nullptr,
-        false, true, kRadius);
-  study("torus R40 r15", sim::Torus(0.04, 0.015), n, aniso, out, nullptr, false, true, kRadius);
+  std::fputs(kStudyHeader, stdout);
+  for (std::size_t t = 0; t < 7; ++t) std::fputs(tables[t].c_str(), stdout);
   std::printf(
       "The paper's claim: Kalman fusion is more accurate than averaging, and both are far "
       "more compact than the raw contacts.\n\n");
 
   // Control: isotropic, constant noise (sigma 1 mm in every direction, no tilt): every contact
   // has the same R, so the Kalman mean is the running mean.
-  sim::SlidingConfig iso;
-  iso.sigma_normal = tactel_sigma(3.4e-3);  // equal to the in-plane quantisation sigma
-  iso.sigma_tilt = 0.0;
-  iso.sigma_position = 0.0;
-  iso.speed = 0.15;
-  iso.seed = 3;
   std::printf("Control: isotropic constant noise (sigma 0.98 mm in every direction, no tilt)\n");
-  study("sphere r40 isotropic", sim::Sphere(0.04), n, iso, {}, nullptr, true, false, kRadius);
+  std::fputs(kStudyHeader, stdout);
+  std::fputs(tables[7].c_str(), stdout);
   std::printf("Theory: with the same isotropic R for every contact, Kalman equals averaging.\n\n");
 
   std::printf(
       "Pad model: a 14x6 DSA-like pad at 3.4 mm (12-bit readings, 0.3 mm depth noise, 0.2 mm and "
       "0.02 rad pose noise) slides, grasps (3 fingers x 2 pads) and palpates; gate 4 mm; each cell "
       "RMS and signed (outside minus inside) error in mm\n");
-  bool header = true;
-  PadTotals totals;
-  for (const auto mode : {sim::ContactMode::per_tactel, sim::ContactMode::per_pad}) {
-    pad_study("sphere r40", sim::Sphere(0.04), quick, mode, header, totals);
-    pad_study("sphere r15", sim::Sphere(0.015), quick, mode, false, totals);
-    pad_study("cylinder r30 h100", sim::Cylinder(0.03, 0.05), quick, mode, false, totals);
-    pad_study("box 80x60x40", sim::Box(Vec3d(0.04, 0.03, 0.02)), quick, mode, false, totals);
-    pad_study("cone r30 h60", sim::Cone(0.03, 0.06), quick, mode, false, totals);
-    pad_study("mesh icosphere r35 (PLY)", mesh, quick, mode, false, totals);
-    pad_study("ellipsoid 100x70x50", sim::Ellipsoid(Vec3d(0.05, 0.035, 0.025)), quick, mode, false,
-              totals);
-    pad_study("torus R40 r15", sim::Torus(0.04, 0.015), quick, mode, false, totals);
-    header = false;
+  std::printf("%-26s %-10s %4s %8s | %-15s | %-15s | %-15s | %-15s\n", "shape", "contacts", "seed",
+              "", "raw rms/signed", "average", "kalman", "surfel (default)");
+  // Rows by mode, then shape, then seed (the jobs are by shape, then mode, then seed).
+  int surfel_wins = 0;
+  for (std::size_t mode = 0; mode < 2; ++mode) {
+    for (std::size_t shape = 0; shape < pads.size() / 6; ++shape) {
+      for (std::size_t seed = 0; seed < 3; ++seed) {
+        const PadLine& l = pads[shape * 6 + mode * 3 + seed];
+        std::fputs(l.text.c_str(), stdout);
+        surfel_wins += l.surfel_ahead ? 1 : 0;
+      }
+    }
   }
   std::printf(
-      "Surfel (the default) ahead of averaging in %d of %d shape x mode x seed runs. Averaging "
+      "Surfel (the default) ahead of averaging in %d of %zu shape x mode x seed runs. Averaging "
       "lands inside a curved surface by the chord sag, Kalman outside by nearly as much; Surfel "
       "removes the sag with the curvature it fits to the contacts' normals.\n\n",
-      totals.surfel_wins, totals.shapes);
+      surfel_wins, pads.size());
 
   io::LinePlot plot;
   plot.title = "RMS distance to the surface against contacts (sphere r40, anisotropic noise)";

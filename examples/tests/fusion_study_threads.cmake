@@ -1,0 +1,30 @@
+# SPDX-License-Identifier: MIT
+# 02_fusion_study --quick prints every table, and prints and writes the same on one thread as
+# on three: every row, every checkpoint of the error curve and every PLY cloud.
+include(${CMAKE_CURRENT_LIST_DIR}/cli_common.cmake)
+
+run_tool("${STUDY}" 0 --quick --out one --threads 1)
+set(one "${out}")
+run_tool("${STUDY}" 0 --quick --out three --threads 3)
+set(three "${out}")
+expect("${three}" "mesh icosphere.*kalman.*isotropic.*kalman.*per pad.*torus.*Surfel .* ahead of averaging in [0-9]+ of 48 .*wrote")
+string(REPLACE "one/" "DIR/" one "${one}")
+string(REPLACE "three/" "DIR/" three "${three}")
+if(NOT one STREQUAL three)
+  message(FATAL_ERROR "02_fusion_study prints differently on 1 and 3 threads:\n${one}\n----\n${three}")
+endif()
+file(GLOB clouds RELATIVE "${WORK_DIR}/one" "${WORK_DIR}/one/*.ply")
+list(LENGTH clouds count)
+if(count LESS 29)
+  message(FATAL_ERROR "02_fusion_study wrote ${count} PLY files, expected 29")
+endif()
+foreach(f ${clouds} error_vs_contacts.svg)
+  file(SHA256 "${WORK_DIR}/one/${f}" a)
+  file(SHA256 "${WORK_DIR}/three/${f}" b)
+  if(NOT a STREQUAL b)
+    message(FATAL_ERROR "02_fusion_study wrote ${f} differently on 1 and 3 threads")
+  endif()
+endforeach()
+
+run_tool("${STUDY}" 2 --threads -1)
+expect("${err}" "--threads")
