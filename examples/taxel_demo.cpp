@@ -290,20 +290,47 @@ Object make_object(std::string name, Shape shape, Symmetry symmetry) {
 }
 
 void fusion_section(const std::vector<Object>& objects, bool quick, const fs::path& out,
-                    Page& page) {
+                    unsigned threads, Page& page) {
   std::fprintf(
       say,
       "\n1. Contact fusion: a three-finger hand (two 14x6 DSA-like pads per finger, 3.4 mm "
       "tactels, 12-bit readings) grasps, palpates and slides over each object\n");
   std::fprintf(say, "%-16s %-8s %8s %7s %8s %8s %8s %7s %8s %10s\n", "object", "policy", "contacts",
                "points", "compact", "mean mm", "rms mm", "max mm", "cover", "signed mm");
+  // Every object's exploration, then every object's fusion and every checkpoint of the error
+  // curve (on the second object's stream), as jobs on `threads` threads; each job fills its
+  // own slot and the slots are reported in order, so the output does not depend on the
+  // thread count.
+  const std::size_t n = objects.size();
+  std::vector<std::vector<Contact<double>>> streams(n);
+  parallel_for(n, threads, [&](std::size_t i) {
+    streams[i] = objects[i].explore(Isometry3d::Identity(), quick, 100 + i);
+  });
+  struct Fused {
+    std::vector<FusionRow> rows;
+    PointCloud<double> surfel;
+    std::vector<double> error;  // of the Surfel points [mm]
+  };
+  std::vector<Fused> fused(n);
+  const std::vector<Contact<double>>& curve_stream = streams[1];
+  std::vector<std::size_t> checkpoints;
+  for (std::size_t k = 500; k < curve_stream.size() * 2; k *= 2) checkpoints.push_back(k);
+  std::vector<std::vector<double>> curve(checkpoints.size());
+  parallel_for(n + checkpoints.size(), threads, [&](std::size_t j) {
+    if (j < n) {
+      Fused& f = fused[j];
+      f.rows = objects[j].fuse_all(streams[j], out, f.surfel);
+      f.error = objects[j].distances(f.surfel.points);
+    } else {
+      const std::size_t c = checkpoints.size() - 1 - (j - n);  // the longest first
+      curve[c] = objects[1].curve(curve_stream, checkpoints[c]);
+    }
+  });
   std::vector<std::vector<std::string>> rows;
   std::vector<std::string> files, views;
-  for (std::size_t i = 0; i < objects.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     const Object& o = objects[i];
-    const auto contacts = o.explore(Isometry3d::Identity(), quick, 100 + i);
-    PointCloud<double> kalman;
-    for (const FusionRow& r : o.fuse_all(contacts, out, kalman)) {
+    for (const FusionRow& r : fused[i].rows) {
       std::fprintf(say, "%-16s %-8s %8zu %7zu %7.1fx %8.3f %8.3f %8.2f %6.1f%% %+10.3f\n",
                    r.object.c_str(), r.policy.c_str(), r.m.contacts, r.m.points, r.m.compaction,
                    1e3 * r.m.error.mean, 1e3 * r.m.error.rms, 1e3 * r.m.error.max,
@@ -324,11 +351,12 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
                       fmt("%+.3f", 1e3 * r.m.error.signed_mean)});
       files.push_back(r.object + "_" + r.policy + ".ply");
     }
+    const PointCloud<double>& kalman = fused[i].surfel;
+    const std::vector<double>& err = fused[i].error;
     io::CloudView view;
     view.title = o.name + ": Surfel cloud, " + std::to_string(kalman.size()) + " points";
     view.value_label = "error mm";
     view.value_min = 0.0;
-    const std::vector<double> err = o.distances(kalman.points);
     io::write_file((out / (o.name + "_kalman.svg")).string(),
                    io::render_cloud_svg(kalman.points, err, view));
     // The colour scale: up to the 95th percentile of the errors (at least 0.05 mm).
@@ -357,19 +385,17 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
               "coverage", "signed mm"},
              rows);
   for (const std::string& v : views) page.raw(v);
-  // Error against contacts, for the first object.
-  const auto contacts = objects[1].explore(Isometry3d::Identity(), quick, 101);
+  // Error against contacts, for the second object.
   io::LinePlot plot;
   plot.title = "RMS error against contacts (" + objects[1].name + ")";
   plot.x_label = "contacts (thousands)";
   plot.y_label = "RMS distance to the surface (mm)";
   plot.y_min = 0.0;
   plot.series = {{"raw", {}, {}}, {"average", {}, {}}, {"kalman", {}, {}}, {"surfel", {}, {}}};
-  for (std::size_t k = 500; k < contacts.size() * 2; k *= 2) {
-    const auto e = objects[1].curve(contacts, k);
+  for (std::size_t c = 0; c < checkpoints.size(); ++c) {
     for (std::size_t s = 0; s < plot.series.size(); ++s) {
-      plot.series[s].x.push_back(double(std::min(k, contacts.size())) / 1000.0);
-      plot.series[s].y.push_back(e[s]);
+      plot.series[s].x.push_back(double(std::min(checkpoints[c], curve_stream.size())) / 1000.0);
+      plot.series[s].y.push_back(curve[c][s]);
     }
   }
   io::write_file((out / "error_vs_contacts.svg").string(), io::render_svg(plot));
@@ -379,8 +405,11 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
 
 // ---- 2. recognition ------------------------------------------------------------------------
 
-void recognition_section(const std::vector<Object>& objects, bool quick, Page& page) {
-  tr::ObjectLibrary<double> lib;
+void recognition_section(const std::vector<Object>& objects, bool quick, unsigned threads,
+                         Page& page) {
+  tr::LibraryConfig config;
+  config.threads = threads;
+  tr::ObjectLibrary<double> lib(config);
   for (const auto& o : objects) lib.add(o.name, o.model(8000));
   const int trials = quick ? 1 : 3;
   const std::size_t n = objects.size();
@@ -482,7 +511,7 @@ void recognition_section(const std::vector<Object>& objects, bool quick, Page& p
 
 // ---- 3. pressure images ----------------------------------------------------------------------
 
-void image_section(bool quick, const fs::path& out, Page& page) {
+void image_section(bool quick, const fs::path& out, unsigned threads, Page& page) {
   // The full run is the size of the paper's data set (and of 06_recognition_study): 25 subjects
   // x 4 classes x 20 grasps x 2 hands = 4000 images.
   const sim::PalmGraspSynth synth({}, 1);
@@ -493,8 +522,11 @@ void image_section(bool quick, const fs::path& out, Page& page) {
   hyb.x.resize(Eigen::Index(data.size()), 32 * 32 + ti::kRegionalFeatures);
   std::vector<io::RgbImage> rows;
   std::vector<bool> shown(5, false);
+  // The whole chain on every image, on `threads` threads (each with its own recogniser).
+  const std::vector<ti::Recognition> all = ti::recognize_all(
+      rec, data.size(), [&](std::size_t i) -> const auto& { return data[i].image; }, threads);
   for (std::size_t i = 0; i < data.size(); ++i) {
-    const ti::Recognition& r = rec.recognize(data[i].image);
+    const ti::Recognition& r = all[i];
     if (!r.ok()) throw std::runtime_error("image " + std::to_string(i) + ": " + r.message);
     conv.x.row(Eigen::Index(i)) = r.regional.transpose();
     hyb.x.row(Eigen::Index(i)) = r.hybrid.transpose();
@@ -505,6 +537,7 @@ void image_section(bool quick, const fs::path& out, Page& page) {
     const auto label = std::size_t(data[i].label);
     if (!shown[label]) {  // one picture row per class: image | segmentation | HPRs | height map
       shown[label] = true;
+      (void)rec.recognize(data[i].image);  // again, for its segmentation and reconstruction
       const ti::Segmentation& seg = rec.segmentation();
       ti::Image<std::uint8_t> hpr = seg.high;
       rows.push_back(io::side_by_side(
@@ -520,6 +553,7 @@ void image_section(bool quick, const fs::path& out, Page& page) {
   const auto cv = [&](const tl::Dataset& d) {
     tl::CvOptions opt;
     opt.seed = 1;
+    opt.threads = threads;
     const tl::CvReport r = tl::cross_validate(
         tl::Scaled<tl::StandardScaler, tl::LinearSvm>(tl::LinearSvm(c)), d.view(), opt);
     return 100.0 * r.accuracy;
@@ -644,6 +678,7 @@ int main(int argc, char** argv) try {
   taxel_cli::check_stdout_at_exit("taxel-demo");
   taxel_cli::print_version_if_asked("taxel-demo", argc, argv);
   bool quick = false;
+  unsigned threads = 0;
   taxel_cli::Format format = taxel_cli::Format::text;
   fs::path out = "taxel-demo-output";
   taxel_cli::Args args("taxel-demo", argc, argv);
@@ -655,13 +690,18 @@ int main(int argc, char** argv) try {
     } else if (a == "--format") {
       format = taxel_cli::to_format(args.choice("text|json|csv"));
       say = format == taxel_cli::Format::text ? stdout : stderr;
+    } else if (a == "--threads") {
+      threads = args.number<unsigned>(0, 4096);
     } else if (a == "-h" || a == "--help") {
       std::puts(
-          "usage: taxel-demo [--quick] [--format text|json|csv] [--version] [OUTPUT-FOLDER]\n"
+          "usage: taxel-demo [--quick] [--format text|json|csv] [--threads N] [--version]\n"
+          "                  [OUTPUT-FOLDER]\n"
           "Runs taxel end to end on simulated data and writes tables, PLY clouds,\n"
           "pictures and an index.html into OUTPUT-FOLDER (default taxel-demo-output).\n"
           "--format json prints the figures as one JSON document on standard output (csv: the\n"
-          "fusion table), the progress going to standard error.");
+          "fusion table), the progress going to standard error. --threads N runs the fusion\n"
+          "and recognition work on N threads (default 0: every core); the figures are the same\n"
+          "for any N.");
       return 0;
     } else if (a.size() > 1 && a[0] == '-') {
       args.fail("unknown option '" + std::string(a) + "' (see --help)");
@@ -685,9 +725,9 @@ int main(int argc, char** argv) try {
   };
   Page page;
   const std::vector<Object> fused(objects.begin(), objects.begin() + 4);
-  fusion_section(fused, quick, out, page);
-  recognition_section(objects, quick, page);
-  image_section(quick, out, page);
+  fusion_section(fused, quick, out, threads, page);
+  recognition_section(objects, quick, threads, page);
+  image_section(quick, out, threads, page);
   session_section(out, page);
   const double seconds = since(t0);
   io::write_file(

@@ -77,10 +77,25 @@ endif()
 
 # --format json: the figures as one JSON document on standard output, progress on standard
 # error; --version.
-execute_process(COMMAND "${DEMO}" --quick --format=json "${WORK_DIR}/json"
-                RESULT_VARIABLE rc OUTPUT_VARIABLE json ERROR_VARIABLE progress)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "taxel-demo --format json: exit ${rc}\n${progress}")
+# On one thread and on three the figures are the same, timings and paths aside.
+foreach(threads 3 1)
+  execute_process(COMMAND "${DEMO}" --quick --format=json --threads ${threads}
+                          "${WORK_DIR}/json${threads}"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE json ERROR_VARIABLE progress)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "taxel-demo --format json --threads ${threads}: exit ${rc}\n${progress}")
+  endif()
+  set(figures "${json}")
+  foreach(path "seconds" "page" "recognition;ms_per_cloud")
+    string(JSON figures ERROR_VARIABLE json_error REMOVE "${figures}" ${path})
+    if(json_error)
+      message(FATAL_ERROR "taxel-demo --format json: no ${path}: ${json_error}\n${json}")
+    endif()
+  endforeach()
+  set(figures${threads} "${figures}")
+endforeach()
+if(NOT figures1 STREQUAL figures3)
+  message(FATAL_ERROR "taxel-demo: other figures on 1 and 3 threads:\n${figures1}\n${figures3}")
 endif()
 string(JSON right ERROR_VARIABLE json_error GET "${json}" recognition right)
 string(JSON policy ERROR_VARIABLE json_error2 GET "${json}" fusion 3 policy)
@@ -95,7 +110,7 @@ if(NOT rc EQUAL 0 OR NOT v MATCHES "^taxel-demo \\(taxel\\) [0-9]+\\.[0-9]+\\.[0
   message(FATAL_ERROR "taxel-demo --version: ${v}")
 endif()
 # Bad options: exit 2 with a one-line reason, nothing run.
-foreach(bad "--format=yaml" "--quick=yes" "--frobnicate")
+foreach(bad "--format=yaml" "--quick=yes" "--frobnicate" "--threads=-1")
   execute_process(COMMAND "${DEMO}" ${bad} "${WORK_DIR}/bad" RESULT_VARIABLE rc
                   OUTPUT_VARIABLE o ERROR_VARIABLE e)
   if(NOT rc EQUAL 2 OR NOT e MATCHES "^taxel-demo: [^\n]+\n$" OR EXISTS "${WORK_DIR}/bad")
