@@ -10,6 +10,7 @@
 // Writes the data set (NPY stack, labels, libsvm feature files), sample pictures, an SVG plot
 // and the printed report into the output folder.
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -17,7 +18,9 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <mutex>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <taxel/image.hpp>
@@ -50,6 +53,8 @@ options:
   --seed S       synthesiser and evaluation seed (default 1)
   --out DIR      output folder (default recognition-study)
   --quick        5 subjects: a smoke run of every step
+  --threads N    folds, replications and noise levels on N threads (default 0: every core);
+                 the tables are the same for any N
   -h, --help     show this help
 )usage";
 
@@ -58,6 +63,7 @@ struct Options {
   int grasps = 10;
   std::uint64_t seed = 1;
   std::string out = "recognition-study";
+  unsigned threads = 0;
 };
 
 [[noreturn]] void die(const std::string& why) {
@@ -83,6 +89,8 @@ Options parse(int argc, char** argv) {
       o.out = std::string(args.value());
     } else if (a == "--quick") {
       o.subjects = 5;
+    } else if (a == "--threads") {
+      o.threads = args.number<unsigned>(0, 4096);
     } else {
       args.fail("unknown argument '" + std::string(a) + "' (see --help)");
     }
@@ -93,6 +101,8 @@ Options parse(int argc, char** argv) {
 
 // The report goes to standard output and to report.txt.
 std::string g_report;
+// Threads for the folds, replications and noise levels (--threads).
+unsigned g_threads = 0;
 void say(const char* fmt, auto... args) {
   char buf[512];
   std::snprintf(buf, sizeof buf, fmt, args...);
@@ -101,8 +111,10 @@ void say(const char* fmt, auto... args) {
   g_report += buf;
 }
 
-// Progress on standard error, overwritten in place.
+// Progress on standard error, overwritten in place (from any thread).
 void progress(const char* stage, std::size_t done, std::size_t total) {
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
   std::fprintf(stderr, "\r  %s %zu/%zu ", stage, done, total);
   if (done == total) std::fputs("\r\033[K", stderr);
   std::fflush(stderr);
@@ -162,29 +174,42 @@ SnrCurves accuracy_vs_snr(const tl::Dataset& d, const std::vector<int>& fold,
                           const std::vector<double>& snr, std::uint64_t seed, const char* stage) {
   SnrCurves acc{std::vector<double>(snr.size(), 0.0), std::vector<double>(snr.size(), 0.0)};
   const int k = 1 + *std::max_element(fold.begin(), fold.end());
-  for (int f = 0; f < k; ++f) {
+  // The folds in parallel, each counting its own hits; the counts are whole numbers, so their
+  // sum does not depend on the order.
+  std::vector<SnrCurves> hits(static_cast<std::size_t>(k), acc);
+  std::atomic<std::size_t> done{0};
+  taxel::parallel_for(static_cast<std::size_t>(k), g_threads, [&](std::size_t fi) {
+    const int f = static_cast<int>(fi);
     std::vector<std::size_t> train, test;
     for (std::size_t i = 0; i < fold.size(); ++i) (fold[i] == f ? test : train).push_back(i);
     const tl::Dataset tr = tl::subset(d.view(), train);
     const tl::Dataset te = tl::subset(d.view(), test);
     Lsvm model = make_lsvm();
     const taxel::Outcome o = model.fit(tr.view());
-    if (!o && o.status != taxel::Status::not_converged) die(std::string(stage) + ": " + o.message);
+    if (!o && o.status != taxel::Status::not_converged) {
+      throw std::runtime_error(std::string(stage) + ": " + o.message);  // rethrown below
+    }
     for (std::size_t s = 0; s < snr.size(); ++s) {
       for (const bool standardise : {false, true}) {
         tl::FeatureMatrix x = te.x;
         if (standardise) model.scaler().transform_in_place(x);
         std::mt19937_64 rng(seed * 1000003U + static_cast<std::uint64_t>(f) * 131U + s);
         if (std::isfinite(snr[s])) tl::add_white_noise(x, snr[s], rng);
-        double& hits = (standardise ? acc.standardised : acc.raw)[s];
+        double& h = (standardise ? hits[fi].standardised : hits[fi].raw)[s];
         for (Eigen::Index i = 0; i < x.rows(); ++i) {
           const Eigen::VectorXd row = x.row(i).transpose();
           const int label = standardise ? model.classifier().predict(row) : model.predict(row);
-          hits += label == te.y[static_cast<std::size_t>(i)] ? 1.0 : 0.0;
+          h += label == te.y[static_cast<std::size_t>(i)] ? 1.0 : 0.0;
         }
       }
     }
-    progress(stage, static_cast<std::size_t>(f + 1), static_cast<std::size_t>(k));
+    progress(stage, done.fetch_add(1) + 1, static_cast<std::size_t>(k));
+  });
+  for (const SnrCurves& h : hits) {
+    for (std::size_t s = 0; s < snr.size(); ++s) {
+      acc.raw[s] += h.raw[s];
+      acc.standardised[s] += h.standardised[s];
+    }
   }
   for (auto* v : {&acc.raw, &acc.standardised}) {
     for (double& c : *v) c = 100.0 * c / static_cast<double>(fold.size());
@@ -202,6 +227,7 @@ tl::CvReport cv_or_die(const tl::Dataset& d, bool grouped, std::uint64_t seed, c
   opt.grouped = grouped;
   opt.seed = seed;
   opt.progress = progress_fn(stage);
+  opt.threads = g_threads;
   tl::CvReport r = tl::cross_validate(make_lsvm(), d.view(), opt);
   if (!r && r.status != taxel::Status::not_converged) die(std::string(stage) + ": " + r.message);
   return r;
@@ -224,6 +250,7 @@ void write_picture(const std::filesystem::path& stem, const taxel::io::RgbImage&
 int main(int argc, char** argv) try {
   taxel_cli::check_stdout_at_exit("06_recognition_study");
   const Options opt = parse(argc, argv);
+  g_threads = opt.threads;
   const auto start = Clock::now();
   const std::filesystem::path out(opt.out);
   std::filesystem::create_directories(out);
@@ -384,6 +411,7 @@ int main(int argc, char** argv) try {
     fo.alpha = 0.10;
     fo.seed = opt.seed;
     fo.progress = progress_fn(name);
+    fo.threads = g_threads;
     const tl::FiveByTwoResult r = tl::five_by_two_cv(other, make_lsvm(), conv.view(), fo);
     if (!r && r.status != taxel::Status::not_converged && r.status != taxel::Status::degenerate) {
       die(std::string("Table 3, ") + name + ": " + r.message);
