@@ -58,6 +58,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -128,6 +129,9 @@ class ContactExtractor {
     depth_.assign(static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols, kNone);
     var_.assign(depth_.size(), 0.0);
     plug_in_.assign(depth_.size(), 0.0);
+    padded_.assign(static_cast<std::size_t>(model_.geometry.rows + 2) * (model_.geometry.cols + 2),
+                   0.0);
+    on_.assign(padded_.size(), 0);
     // lambda(a) and lambda''(a) on a grid of a (lambda' = lambda (lambda - a),
     // lambda'' = lambda' (lambda - a) + lambda (lambda' - 1)), for the refined correction.
     for (int i = 0; i < kTable; ++i) {
@@ -207,8 +211,9 @@ class ContactExtractor {
     const double vn = var_along + sp2 + lever2 * st2 / 3.0 + q2() * slope_var;
     Contact<double> c;
     c.position = T * Vec3d(x, y, -depth);
-    Vec3d n = T.linear() * n_pad;  // unit already when T's rotation is orthonormal; made sure
-    n *= 1.0 / std::sqrt(n.squaredNorm());
+    Vec3d n = T.linear() * n_pad;       // unit already when T's rotation is orthonormal; made sure:
+    const double n2 = n.squaredNorm();  // one Newton step for 1 / |n| when |n| is near 1
+    n *= std::abs(n2 - 1.0) < 1e-6 ? 1.5 - 0.5 * n2 : 1.0 / std::sqrt(n2);
     c.covariance = Mat3d::Identity() * vt + (vn - vt) * (n * n.transpose());
     c.normal = n;
     c.pressure = pressure;
@@ -224,6 +229,19 @@ class ContactExtractor {
     const double vd = depth_variance();
     const double fb2 = options_.fallback_normal_sigma * options_.fallback_normal_sigma;
     const double inv_p = 1.0 / p, inv_p2 = inv_p * inv_p;
+    const std::size_t pc = static_cast<std::size_t>(g.cols) + 2;  // padded row length
+    const std::array<PlaneWeights, 512>& weights = plane_weights();
+    if (options_.local_normals) {
+      // The depths and the active flags with a border of inactive tactels around the pad.
+      for (int r = 0; r < g.rows; ++r) {
+        for (int c = 0; c < g.cols; ++c) {
+          const double d = depth_[static_cast<std::size_t>(r) * g.cols + c];
+          const std::size_t at = static_cast<std::size_t>(r + 1) * pc + (c + 1);
+          on_[at] = d != kNone;
+          padded_[at] = d != kNone ? d : 0.0;
+        }
+      }
+    }
     std::size_t added = 0;
     for (int r = 0; r < g.rows; ++r) {
       for (int c = 0; c < g.cols; ++c) {
@@ -231,51 +249,26 @@ class ContactExtractor {
         if (d0 == kNone) continue;
         double gx = 0, gy = 0, vgx = 0, vgy = 0;  // slopes of d per metre and their variances
         if (options_.local_normals) {
-          // Least-squares plane over the active 3x3 neighbourhood, in pitch units.
-          double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0, sd = 0, sxd = 0, syd = 0;
-          for (int dr = -1; dr <= 1; ++dr) {
-            const int rr = r + dr;
-            if (rr < 0 || rr >= g.rows) continue;
-            for (int dc = -1; dc <= 1; ++dc) {
-              const int cc = c + dc;
-              if (cc < 0 || cc >= g.cols) continue;
-              const double d = depth_[static_cast<std::size_t>(rr) * g.cols + cc];
-              if (d == kNone) continue;
-              n += 1;
-              sx += dc;
-              sy += dr;
-              sxx += dc * dc;
-              syy += dr * dr;
-              sxy += dc * dr;
-              sd += d;
-              sxd += dc * d;
-              syd += dr * d;
-            }
+          // Least-squares plane over the active 3x3 neighbourhood: linear in the depths, with
+          // weights that depend only on which neighbours are active (plane_weights).
+          const std::size_t at = static_cast<std::size_t>(r + 1) * pc + (c + 1);
+          const std::size_t up = at - pc, down = at + pc;
+          const double nd[9] = {padded_[up - 1],   padded_[up],   padded_[up + 1],
+                                padded_[at - 1],   padded_[at],   padded_[at + 1],
+                                padded_[down - 1], padded_[down], padded_[down + 1]};
+          const unsigned mask = unsigned(on_[up - 1]) | unsigned(on_[up]) << 1 |
+                                unsigned(on_[up + 1]) << 2 | unsigned(on_[at - 1]) << 3 | 1u << 4 |
+                                unsigned(on_[at + 1]) << 5 | unsigned(on_[down - 1]) << 6 |
+                                unsigned(on_[down]) << 7 | unsigned(on_[down + 1]) << 8;
+          const PlaneWeights& w = weights[mask];
+          for (int k = 0; k < 9; ++k) {
+            gx += w.wx[k] * nd[k];
+            gy += w.wy[k] * nd[k];
           }
-          // One division each for 1/n and 1/det: the per-tactel cost is dominated by them.
-          const double inv_n = 1.0 / n;
-          const double cxx = sxx - sx * sx * inv_n, cyy = syy - sy * sy * inv_n,
-                       cxy = sxy - sx * sy * inv_n;
-          const double cxd = sxd - sx * sd * inv_n, cyd = syd - sy * sd * inv_n;
-          const double det = cxx * cyy - cxy * cxy;
-          constexpr double kTiny = 1e-9;
-          if (cxx > kTiny && cyy > kTiny && det > 0.1 * cxx * cyy) {
-            const double inv_det = 1.0 / det;
-            gx = (cyy * cxd - cxy * cyd) * inv_det * inv_p;
-            gy = (cxx * cyd - cxy * cxd) * inv_det * inv_p;
-            vgx = vd * cyy * inv_det * inv_p2;
-            vgy = vd * cxx * inv_det * inv_p2;
-          } else if (cxx > kTiny && std::abs(cxy) <= kTiny) {  // a row: x slope only
-            gx = cxd / cxx * inv_p;
-            vgx = vd / cxx * inv_p2;
-            vgy = fb2;
-          } else if (cyy > kTiny && std::abs(cxy) <= kTiny) {  // a column: y slope only
-            gy = cyd / cyy * inv_p;
-            vgy = vd / cyy * inv_p2;
-            vgx = fb2;
-          } else {
-            vgx = vgy = fb2;
-          }
+          gx *= inv_p;
+          gy *= inv_p;
+          vgx = w.fx < 0 ? fb2 : vd * w.fx * inv_p2;
+          vgy = w.fy < 0 ? fb2 : vd * w.fy * inv_p2;
         }
         // The outward normal -(gx, gy, 1) / |(gx, gy, 1)|, with one division.
         const double scale = -1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
@@ -489,6 +482,62 @@ class ContactExtractor {
     double x, y, measured, jensen;
   };
   std::vector<Active> active_;
+  // per_tactel's workspace: depths (0 where inactive) and active flags of the pad with a
+  // border of inactive tactels, (rows + 2) x (cols + 2).
+  mutable std::vector<double> padded_;
+  mutable std::vector<unsigned char> on_;
+
+  // The plane fit of step 2 for one pattern of active neighbours (bit 3 (dr + 1) + (dc + 1) of
+  // the 3x3 neighbourhood, the centre always set): the slopes in pitch units are
+  // sum_k wx[k] d_k and sum_k wy[k] d_k, and their variances (depth variance) * f / pitch^2,
+  // f < 0 meaning not measured (the fallback variance).
+  struct PlaneWeights {
+    double wx[9], wy[9];
+    double fx, fy;
+  };
+  static const std::array<PlaneWeights, 512>& plane_weights() {
+    static const std::array<PlaneWeights, 512> table = [] {
+      std::array<PlaneWeights, 512> t{};
+      for (unsigned mask = 0; mask < 512; ++mask) {
+        PlaneWeights& w = t[mask];
+        double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+        for (int k = 0; k < 9; ++k) {
+          if (!(mask >> k & 1u)) continue;
+          const double dc = k % 3 - 1, dr = k / 3 - 1;
+          n += 1;
+          sx += dc;
+          sy += dr;
+          sxx += dc * dc;
+          syy += dr * dr;
+          sxy += dc * dr;
+        }
+        w.fx = w.fy = -1.0;
+        if (n == 0) continue;
+        const double mx = sx / n, my = sy / n;
+        const double cxx = sxx - sx * mx, cyy = syy - sy * my, cxy = sxy - sx * my;
+        const double det = cxx * cyy - cxy * cxy;
+        constexpr double kTiny = 1e-9;
+        for (int k = 0; k < 9; ++k) {
+          if (!(mask >> k & 1u)) continue;
+          const double ux = k % 3 - 1 - mx, uy = k / 3 - 1 - my;
+          if (cxx > kTiny && cyy > kTiny && det > 0.1 * cxx * cyy) {
+            w.wx[k] = (cyy * ux - cxy * uy) / det;
+            w.wy[k] = (cxx * uy - cxy * ux) / det;
+            w.fx = cyy / det;
+            w.fy = cxx / det;
+          } else if (cxx > kTiny && std::abs(cxy) <= kTiny) {  // a row: x slope only
+            w.wx[k] = ux / cxx;
+            w.fx = 1.0 / cxx;
+          } else if (cyy > kTiny && std::abs(cxy) <= kTiny) {  // a column: y slope only
+            w.wy[k] = uy / cyy;
+            w.fy = 1.0 / cyy;
+          }
+        }
+      }
+      return t;
+    }();
+    return table;
+  }
   // lambda and lambda'' tabulated at a = kTableLow + i / kTableScale.
   static constexpr int kTable = 641;  // a in [-12, 8]
   static constexpr double kTableLow = -12.0, kTableScale = 32.0;
