@@ -61,6 +61,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -126,9 +127,26 @@ class ContactExtractor {
         bias_[static_cast<std::size_t>(k)] = b;
       }
     }
-    depth_.assign(static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols, kNone);
-    var_.assign(depth_.size(), 0.0);
-    plug_in_.assign(depth_.size(), 0.0);
+    const std::size_t tactels = static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols;
+    active_.resize(tactels);
+    listed_.resize(tactels);
+    cell_.resize(tactels);
+    for (std::size_t i = 0; i < tactels; ++i) {
+      const std::size_t cols = static_cast<std::size_t>(model_.geometry.cols);
+      cell_[i] = (i / cols + 1) * (cols + 2) + i % cols + 1;
+    }
+    // The monomials of the quadric fit per tactel (pad coordinates in pitch units are
+    // half-integers, so their sums are exact in any order).
+    monomials_.resize(tactels);
+    for (int r = 0; r < model_.geometry.rows; ++r) {
+      for (int c = 0; c < model_.geometry.cols; ++c) {
+        const double X = c - 0.5 * (model_.geometry.cols - 1), Y = r - 0.5 * (model_.geometry.rows - 1);
+        monomials_[static_cast<std::size_t>(r) * model_.geometry.cols + c] = {
+            1.0,       X,         Y,         X * X,         X * Y,         Y * Y,
+            X * X * X, X * X * Y, X * Y * Y, Y * Y * Y,     X * X * X * X, X * X * X * Y,
+            X * X * Y * Y, X * Y * Y * Y, Y * Y * Y * Y, 0.0};
+      }
+    }
     padded_.assign(static_cast<std::size_t>(model_.geometry.rows + 2) * (model_.geometry.cols + 2),
                    0.0);
     on_.assign(padded_.size(), 0);
@@ -160,29 +178,39 @@ class ContactExtractor {
     if (!T_world_pad.matrix().allFinite()) {
       throw std::invalid_argument("ContactExtractor: the pad pose is not finite");
     }
+    // The previous frame's active cells back to inactive, the list of active tactels by a
+    // branch-free pass over the readings, then their plug-in depths into the padded grid.
+    for (std::size_t i = 0; i < active_count_; ++i) {
+      padded_[active_[i].at] = 0.0;
+      on_[active_[i].at] = 0;
+    }
     const int saturated = model_.levels - 1;
     const double dq = model_.depth_per_count();
     const double vd = depth_variance();
-    std::size_t active = 0;
-    for (int r = 0; r < g.rows; ++r) {
-      for (int c = 0; c < g.cols; ++c) {
-        const int k = counts(r, c);
-        double& d = depth_[static_cast<std::size_t>(r) * g.cols + c];
-        if (k >= model_.threshold && k < saturated) {
-          const double b = bias_[static_cast<std::size_t>(k)];
-          d = k * dq - b;
-          plug_in_[static_cast<std::size_t>(r) * g.cols + c] = b;
-          var_[static_cast<std::size_t>(r) * g.cols + c] = vd + b * b;
-          ++active;
-        } else {
-          d = kNone;
-        }
-      }
+    const std::uint16_t* reading = counts.data();
+    const std::size_t tactels = static_cast<std::size_t>(g.rows) * g.cols;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < tactels; ++i) {
+      const int k = reading[i];
+      listed_[n] = static_cast<std::uint32_t>(i);
+      n += (k >= model_.threshold) & (k < saturated);
     }
-    if (active == 0) return 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::size_t i = listed_[j];
+      const int k = reading[i];
+      const std::size_t at = cell_[i];
+      const double b = bias_[static_cast<std::size_t>(k)];
+      const double m = k * dq;
+      padded_[at] = m - b;
+      on_[at] = 1;
+      active_[j] = {at, i, monomials_[i][1], monomials_[i][2], m, 0.0, vd + b * b, b, double(k)};
+    }
+    active_count_ = n;
+    factored_ = false;
+    if (n == 0) return 0;
     if (options_.correct_censoring && options_.refine_censoring) refine_censoring();
-    return options_.mode == ContactMode::per_tactel ? per_tactel(counts, T_world_pad, time, out)
-                                                    : per_pad(counts, T_world_pad, time, out);
+    return options_.mode == ContactMode::per_tactel ? per_tactel(T_world_pad, time, out)
+                                                    : per_pad(T_world_pad, time, out);
   }
 
   /// The sensor model in use.
@@ -191,7 +219,6 @@ class ContactExtractor {
   const ContactOptions& options() const noexcept { return options_; }
 
  private:
-  static constexpr double kNone = -std::numeric_limits<double>::infinity();
 
   double depth_variance() const {
     const double dq = model_.depth_per_count();
@@ -201,28 +228,28 @@ class ContactExtractor {
   // The contact at pad point (x, y, -depth) with outward normal n_pad (pad frame), extra
   // variance along the normal and the slope variances of that normal.
   template <class = void>
-  Contact<double> make(const Eigen::Isometry3d& T, double x, double y, double depth,
-                       const Vec3d& n_pad, double var_along, double var_across, double slope_var,
-                       double pressure, double time) const {
+  void make(std::vector<Contact<double>>& out, const Eigen::Isometry3d& T, double x, double y,
+            double depth, const Vec3d& n_pad, double var_along, double var_across,
+            double slope_var, double pressure, double time) const {
     const double lever2 = x * x + y * y;
     const double st2 = model_.sigma_tilt * model_.sigma_tilt;
     const double sp2 = model_.sigma_position * model_.sigma_position;
     const double vt = var_across + sp2 + lever2 * st2 / 6.0;
     const double vn = var_along + sp2 + lever2 * st2 / 3.0 + q2() * slope_var;
-    Contact<double> c;
-    c.position = T * Vec3d(x, y, -depth);
     Vec3d n = T.linear() * n_pad;       // unit already when T's rotation is orthonormal; made sure:
     const double n2 = n.squaredNorm();  // one Newton step for 1 / |n| when |n| is near 1
     n *= std::abs(n2 - 1.0) < 1e-6 ? 1.5 - 0.5 * n2 : 1.0 / std::sqrt(n2);
-    c.covariance = Mat3d::Identity() * vt + (vn - vt) * (n * n.transpose());
-    c.normal = n;
-    c.pressure = pressure;
-    c.time = time;
-    return c;
+    // vt I + (vn - vt) n n', written out (symmetric).
+    const double dv = vn - vt;
+    const double cxy = dv * n.x() * n.y(), cxz = dv * n.x() * n.z(), cyz = dv * n.y() * n.z();
+    Mat3d cov;
+    cov << vt + dv * n.x() * n.x(), cxy, cxz, cxy, vt + dv * n.y() * n.y(), cyz, cxz, cyz,
+        vt + dv * n.z() * n.z();
+    out.emplace_back(T * Vec3d(x, y, -depth), cov, n, pressure, time);
   }
 
   template <class = void>
-  std::size_t per_tactel(const PadMatrix& counts, const Eigen::Isometry3d& T, double time,
+  std::size_t per_tactel(const Eigen::Isometry3d& T, double time,
                          std::vector<Contact<double>>& out) const {
     const PadGeometry& g = model_.geometry;
     const double p = g.pitch;
@@ -231,57 +258,37 @@ class ContactExtractor {
     const double inv_p = 1.0 / p, inv_p2 = inv_p * inv_p;
     const std::size_t pc = static_cast<std::size_t>(g.cols) + 2;  // padded row length
     const std::array<PlaneWeights, 512>& weights = plane_weights();
-    if (options_.local_normals) {
-      // The depths and the active flags with a border of inactive tactels around the pad.
-      for (int r = 0; r < g.rows; ++r) {
-        for (int c = 0; c < g.cols; ++c) {
-          const double d = depth_[static_cast<std::size_t>(r) * g.cols + c];
-          const std::size_t at = static_cast<std::size_t>(r + 1) * pc + (c + 1);
-          on_[at] = d != kNone;
-          padded_[at] = d != kNone ? d : 0.0;
-        }
+    for (std::size_t i = 0; i < active_count_; ++i) {
+      const Active& e = active_[i];
+      double gx = 0, gy = 0, vgx = 0, vgy = 0;  // slopes of d per metre and their variances
+      if (options_.local_normals) {
+        // Least-squares plane over the active 3x3 neighbourhood: linear in the depths, with
+        // weights that depend only on which neighbours are active (plane_weights).
+        const std::size_t at = e.at, up = at - pc, down = at + pc;
+        const double* u = &padded_[up - 1];
+        const double* m = &padded_[at - 1];
+        const double* v = &padded_[down - 1];
+        const unsigned mask = unsigned(on_[up - 1]) | unsigned(on_[up]) << 1 |
+                              unsigned(on_[up + 1]) << 2 | unsigned(on_[at - 1]) << 3 | 1u << 4 |
+                              unsigned(on_[at + 1]) << 5 | unsigned(on_[down - 1]) << 6 |
+                              unsigned(on_[down]) << 7 | unsigned(on_[down + 1]) << 8;
+        const PlaneWeights& w = weights[mask];
+        // Inactive cells hold 0, so the sums over the whole 3x3 block are the active ones'.
+        const double sum = (u[0] + u[1] + u[2]) + (m[0] + m[1] + m[2]) + (v[0] + v[1] + v[2]);
+        const double sum_x = (u[2] + m[2] + v[2]) - (u[0] + m[0] + v[0]);
+        const double sum_y = (v[0] + v[1] + v[2]) - (u[0] + u[1] + u[2]);
+        gx = (w.x[0] * sum_x + w.x[1] * sum_y + w.x[2] * sum) * inv_p;
+        gy = (w.y[0] * sum_x + w.y[1] * sum_y + w.y[2] * sum) * inv_p;
+        vgx = w.fx < 0 ? fb2 : vd * w.fx * inv_p2;
+        vgy = w.fy < 0 ? fb2 : vd * w.fy * inv_p2;
       }
+      // The outward normal -(gx, gy, 1) / |(gx, gy, 1)|, with one division.
+      const double scale = -1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
+      const Vec3d n_pad(gx * scale, gy * scale, scale);
+      make(out, T, e.x * p, e.y * p, padded_[e.at], n_pad, e.var, q2(), vgx + vgy, e.pressure,
+           time);
     }
-    std::size_t added = 0;
-    for (int r = 0; r < g.rows; ++r) {
-      for (int c = 0; c < g.cols; ++c) {
-        const double d0 = depth_[static_cast<std::size_t>(r) * g.cols + c];
-        if (d0 == kNone) continue;
-        double gx = 0, gy = 0, vgx = 0, vgy = 0;  // slopes of d per metre and their variances
-        if (options_.local_normals) {
-          // Least-squares plane over the active 3x3 neighbourhood: linear in the depths, with
-          // weights that depend only on which neighbours are active (plane_weights).
-          const std::size_t at = static_cast<std::size_t>(r + 1) * pc + (c + 1);
-          const std::size_t up = at - pc, down = at + pc;
-          const double nd[9] = {padded_[up - 1],   padded_[up],   padded_[up + 1],
-                                padded_[at - 1],   padded_[at],   padded_[at + 1],
-                                padded_[down - 1], padded_[down], padded_[down + 1]};
-          const unsigned mask = unsigned(on_[up - 1]) | unsigned(on_[up]) << 1 |
-                                unsigned(on_[up + 1]) << 2 | unsigned(on_[at - 1]) << 3 | 1u << 4 |
-                                unsigned(on_[at + 1]) << 5 | unsigned(on_[down - 1]) << 6 |
-                                unsigned(on_[down]) << 7 | unsigned(on_[down + 1]) << 8;
-          const PlaneWeights& w = weights[mask];
-          for (int k = 0; k < 9; ++k) {
-            gx += w.wx[k] * nd[k];
-            gy += w.wy[k] * nd[k];
-          }
-          gx *= inv_p;
-          gy *= inv_p;
-          vgx = w.fx < 0 ? fb2 : vd * w.fx * inv_p2;
-          vgy = w.fy < 0 ? fb2 : vd * w.fy * inv_p2;
-        }
-        // The outward normal -(gx, gy, 1) / |(gx, gy, 1)|, with one division.
-        const double scale = -1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
-        const Vec3d n_pad(gx * scale, gy * scale, scale);
-        const Vec3d at = g.tactel(r, c);
-        const int k = counts(r, c);
-        out.push_back(make(T, at.x(), at.y(), d0, n_pad,
-                           var_[static_cast<std::size_t>(r) * g.cols + c], q2(), vgx + vgy,
-                           double(k), time));
-        ++added;
-      }
-    }
-    return added;
+    return active_count_;
   }
 
   // The refined censoring correction (the model above, step 1): quadric fit of the plug-in
@@ -290,58 +297,55 @@ class ContactExtractor {
   // determined or it does not fit.
   template <class = void>
   void refine_censoring() {
-    const PadGeometry& g = model_.geometry;
     const double dq = model_.depth_per_count();
     const double sigma = model_.sigma_normal;
-    if (!(sigma > 0)) return;
+    const std::size_t count = active_count_;
+    if (!(sigma > 0) || count < 7) return;
     const double t = (model_.threshold - 0.5) * dq;
-    const double x0 = 0.5 * (g.cols - 1), y0 = 0.5 * (g.rows - 1);
-    // Pass 0's normal equations, on the plug-in depths.
-    active_.clear();
-    double ata[36] = {}, sol[6] = {};
-    for (int r = 0; r < g.rows; ++r) {
-      for (int c = 0; c < g.cols; ++c) {
-        const std::size_t i = static_cast<std::size_t>(r) * g.cols + c;
-        const double d = depth_[i];
-        if (d == kNone) continue;
-        const double X = c - x0, Y = r - y0;
-        const double row[6] = {1.0, X, Y, X * X, X * Y, Y * Y};
-        for (int a = 0; a < 6; ++a) {
-          sol[a] += row[a] * d;
-          for (int b = 0; b <= a; ++b) ata[a * 6 + b] += row[a] * row[b];
-        }
-        active_.push_back({i, X, Y, d + plug_in_[i], 0.0});
-      }
+    // Pass 0's normal equations, on the plug-in depths: the moments of the active tactels'
+    // coordinates, and the right-hand side.
+    double* ata = factor_;  // factored in place, kept for per_pad
+    double sol[6] = {};
+    normal_matrix(ata);
+    for (std::size_t i = 0; i < count; ++i) {
+      const double d = padded_[active_[i].at];
+      const double* row = monomials_[active_[i].tactel].data();
+      for (int a = 0; a < 6; ++a) sol[a] += row[a] * d;
     }
-    const double n = static_cast<double>(active_.size());
-    double inv_diag[6];
-    if (n < 7 || !detail_cholesky(ata, 6, inv_diag)) return;
+    const double n = static_cast<double>(count);
+    double* inv_diag = factor_inv_diag_;
+    if (!detail_cholesky(ata, 6, inv_diag)) return;
+    factored_ = true;
     detail_solve(ata, 6, inv_diag, sol);
     const double vd = depth_variance();
     const double half_v_over_sigma = 0.5 * vd / sigma, inv_sigma = 1.0 / sigma;
     // The correction at fitted depth f: d = measured - sigma lambda(a) + jensen lambda''(a),
     // a = (t - f) / sigma, by linear interpolation in the tables (a clamped to their range; f
-    // itself is not clamped at 0: the fit's noise is symmetric, a clamp would bias it), and
-    // the variance of the corrected depth: the truncated normal's, sigma^2 (1 - lambda'),
-    // plus the fit's share through the correction's slope lambda'.
-    const auto correct = [&](const Active& e, double f) {
+    // itself is not clamped at 0: the fit's noise is symmetric, a clamp would bias it), and,
+    // when `with_variance`, the variance of the corrected depth: the truncated normal's,
+    // sigma^2 (1 - lambda'), plus the fit's share through the correction's slope lambda'.
+    const auto correct = [&](Active& e, double f, bool with_variance) {
       const double a = (t - f) * inv_sigma;
       const double u = std::clamp((a - kTableLow) * kTableScale, 0.0, double(kTable - 1) - 1e-9);
       const int k = static_cast<int>(u);
       const double w = u - k;
       const double lam = lambda_[k][0] + w * (lambda_[k + 1][0] - lambda_[k][0]);
       const double l2 = lambda_[k][1] + w * (lambda_[k + 1][1] - lambda_[k][1]);
-      const double l1 = lam * (lam - a);
-      depth_[e.index] = e.measured - sigma * lam + e.jensen * l2;
-      var_[e.index] = vd * (1.0 - l1) + l1 * l1 * e.jensen * 2.0 * sigma;
+      padded_[e.at] = e.measured - sigma * lam + e.jensen * l2;
+      if (with_variance) {
+        const double l1 = lam * (lam - a);
+        e.var = vd * (1.0 - l1) + l1 * l1 * e.jensen * 2.0 * sigma;
+      }
     };
     const auto fitted = [](const double* q, const Active& e) {
       return q[0] + e.x * (q[1] + q[3] * e.x + q[4] * e.y) + e.y * (q[2] + q[5] * e.y);
     };
     // Pass 0: leverages, residuals, corrections at the first fit, pass 1's right-hand side.
     double rss = 0, sol1[6] = {};
-    for (Active& e : active_) {
-      double y[6] = {1.0, e.x, e.y, e.x * e.x, e.x * e.y, e.y * e.y};
+    for (std::size_t i = 0; i < count; ++i) {
+      Active& e = active_[i];
+      const double* row = monomials_[e.tactel].data();
+      double y[6] = {row[0], row[1], row[2], row[3], row[4], row[5]};
       double h = 0;
       for (int a = 0; a < 6; ++a) {  // leverage |L^-1 row|^2
         for (int b = 0; b < a; ++b) y[a] -= ata[a * 6 + b] * y[b];
@@ -350,52 +354,63 @@ class ContactExtractor {
       }
       e.jensen = h * half_v_over_sigma;
       const double f = fitted(sol, e);
-      const double res = depth_[e.index] - f;
+      const double res = padded_[e.at] - f;
       rss += res * res;
-      correct(e, f);
-      const double d = depth_[e.index];
-      const double row[6] = {1.0, e.x, e.y, e.x * e.x, e.x * e.y, e.y * e.y};
+      correct(e, f, false);
+      const double d = padded_[e.at];
       for (int a = 0; a < 6; ++a) sol1[a] += row[a] * d;
     }
     // A chi-square test of the residuals, at about 3 standard deviations of their sum.
     if (!(rss <= vd * (n - 6 + 3 * std::sqrt(2 * (n - 6))))) {
       // Not a quadric (an edge, a corner): back to the plug-in depths.
-      for (const Active& e : active_) {
-        const double b = plug_in_[e.index];
-        depth_[e.index] = e.measured - b;
-        var_[e.index] = vd + b * b;
+      for (std::size_t i = 0; i < count; ++i) {
+        Active& e = active_[i];
+        padded_[e.at] = e.measured - e.plug_in;
       }
       return;
     }
     // Pass 1: the corrections at the refit.
     detail_solve(ata, 6, inv_diag, sol1);
-    for (const Active& e : active_) correct(e, fitted(sol1, e));
+    for (std::size_t i = 0; i < count; ++i) correct(active_[i], fitted(sol1, active_[i]), true);
+  }
+
+  // The lower triangle (row stride 6; the upper one is not written) of the quadric fit's
+  // normal matrix over the rows 1, X, Y, X^2, XY, Y^2 of the active tactels, from the sums of
+  // their monomials.
+  void normal_matrix(double* a) const {
+    double m[16] = {};
+    for (std::size_t i = 0; i < active_count_; ++i) {
+      const double* mono = monomials_[active_[i].tactel].data();
+      for (int k = 0; k < 16; ++k) m[k] += mono[k];
+    }
+    a[0] = m[0];
+    a[6] = m[1], a[7] = m[3];
+    a[12] = m[2], a[13] = m[4], a[14] = m[5];
+    a[18] = m[3], a[19] = m[6], a[20] = m[7], a[21] = m[10];
+    a[24] = m[4], a[25] = m[7], a[26] = m[8], a[27] = m[11], a[28] = m[12];
+    a[30] = m[5], a[31] = m[8], a[32] = m[9], a[33] = m[12], a[34] = m[13], a[35] = m[14];
   }
 
   double q2() const { return model_.geometry.pitch * model_.geometry.pitch / 12.0; }
 
   template <class = void>
-  std::size_t per_pad(const PadMatrix& counts, const Eigen::Isometry3d& T, double time,
+  std::size_t per_pad(const Eigen::Isometry3d& T, double time,
                       std::vector<Contact<double>>& out) const {
     const PadGeometry& g = model_.geometry;
     const double p = g.pitch;
     const double vd = depth_variance();
-    const double x0 = 0.5 * (g.cols - 1), y0 = 0.5 * (g.rows - 1);
+    const std::size_t count = active_count_;
     // Centroid of the active tactels, in pitch units from the pad centre (see the model above),
     // and the sum of their readings (the contact's pressure).
     double w = 0, wx = 0, wy = 0, corr2 = 0;
-    int n = 0;
-    for (int r = 0; r < g.rows; ++r) {
-      for (int c = 0; c < g.cols; ++c) {
-        if (depth_[static_cast<std::size_t>(r) * g.cols + c] == kNone) continue;
-        const double k = counts(r, c);
-        w += k;
-        wx += c - x0;
-        wy += r - y0;
-        corr2 += var_[static_cast<std::size_t>(r) * g.cols + c] - vd;
-        ++n;
-      }
+    for (std::size_t i = 0; i < count; ++i) {
+      const Active& e = active_[i];
+      w += e.pressure;
+      wx += e.x;
+      wy += e.y;
+      corr2 += e.var - vd;
     }
+    const double n = static_cast<double>(count);
     const double xc = wx / n, yc = wy / n;
     // Least squares of the depths on 1, X, Y, X^2, XY, Y^2 (X, Y from the centroid). A plane
     // or a mean cannot say how the surface curves, and its value above the centroid lies below
@@ -403,38 +418,44 @@ class ContactExtractor {
     // on a 15 mm sphere under a 3.4 mm pitch pad). So when fewer than six tactels are active,
     // or they do not determine a quadric (a pivot vanishes: one or two rows), the tactels give
     // their contacts one by one.
-    if (n < 6) return per_tactel(counts, T, time, out);
-    double ata[36] = {}, sol[6] = {}, inv_diag[3] = {};
-    for (int r = 0; r < g.rows; ++r) {
-      for (int c = 0; c < g.cols; ++c) {
-        const double d = depth_[static_cast<std::size_t>(r) * g.cols + c];
-        if (d == kNone) continue;
-        const double X = c - x0 - xc, Y = r - y0 - yc;
-        const double row[6] = {1.0, X, Y, X * X, X * Y, Y * Y};
-        for (int i = 0; i < 6; ++i) {
-          sol[i] += row[i] * d;
-          for (int j = 0; j <= i; ++j) ata[i * 6 + j] += row[i] * row[j];
-        }
-      }
+    if (count < 6) return per_tactel(T, time, out);
+    // The quadric in pad coordinates (its normal matrix factored already when the refined
+    // censoring correction ran on this frame), then its value and slopes at the centroid, and
+    // their variances e' A^-1 e = |L^-1 e|^2 (per unit depth variance).
+    double local[36], local_inv[6];
+    const double* l = factor_;
+    const double* inv_l = factor_inv_diag_;
+    if (!factored_) {
+      normal_matrix(local);
+      if (!detail_cholesky(local, 6, local_inv)) return per_tactel(T, time, out);
+      l = local;
+      inv_l = local_inv;
     }
-    double inv_l[6];
-    if (!detail_cholesky(ata, 6, inv_l)) return per_tactel(counts, T, time, out);
-    detail_solve(ata, 6, inv_l, sol);
-    for (int i = 0; i < 3; ++i) {
-      double e[6] = {};
-      e[i] = 1.0;
-      detail_solve(ata, 6, inv_l, e);
-      inv_diag[i] = e[i];
+    double sol[6] = {};
+    for (std::size_t i = 0; i < count; ++i) {
+      const double d = padded_[active_[i].at];
+      const double* row = monomials_[active_[i].tactel].data();
+      for (int a = 0; a < 6; ++a) sol[a] += row[a] * d;
+    }
+    detail_solve(l, 6, inv_l, sol);
+    double e0[6] = {1.0, xc, yc, xc * xc, xc * yc, yc * yc};  // d/d(1, X, Y) of the rows
+    double ex[6] = {0.0, 1.0, 0.0, 2.0 * xc, yc, 0.0};
+    double ey[6] = {0.0, 0.0, 1.0, 0.0, xc, 2.0 * yc};
+    double fit[3] = {}, inv_diag[3];
+    int k = 0;
+    for (double* e : {e0, ex, ey}) {
+      for (int a = 0; a < 6; ++a) fit[k] += e[a] * sol[a];
+      inv_diag[k++] = detail_forward_norm2(l, 6, inv_l, e);
     }
     double gx = 0, gy = 0, slope_var = 0.0;
     if (options_.local_normals) {
-      gx = sol[1] / p;
-      gy = sol[2] / p;
+      gx = fit[1] / p;
+      gy = fit[2] / p;
       slope_var = vd * (inv_diag[1] + inv_diag[2]) / (p * p);
     }
     const Vec3d n_pad = -Vec3d(gx, gy, 1.0).normalized();
-    const double var_a = vd * inv_diag[0] + std::max(corr2, 0.0) / (double(n) * n);
-    out.push_back(make(T, xc * p, yc * p, sol[0], n_pad, var_a, q2(), slope_var, w, time));
+    const double var_a = vd * inv_diag[0] + std::max(corr2, 0.0) / (n * n);
+    make(out, T, xc * p, yc * p, fit[0], n_pad, var_a, q2(), slope_var, w, time);
     return 1;
   }
 
@@ -469,30 +490,51 @@ class ContactExtractor {
     }
   }
 
+  // |L^-1 e|^2 by forward substitution with the factor of detail_cholesky; overwrites e.
+  static double detail_forward_norm2(const double* l, int m, const double* inv_diag, double* e) {
+    double s = 0;
+    for (int i = 0; i < m; ++i) {
+      for (int k = 0; k < i; ++k) e[i] -= l[i * 6 + k] * e[k];
+      e[i] *= inv_diag[i];
+      s += e[i] * e[i];
+    }
+    return s;
+  }
+
   SensorModel model_;
   ContactOptions options_;
-  std::vector<double> bias_;     // truncation bias by reading count [m]
-  std::vector<double> depth_;    // corrected depth per tactel [m]; kNone when not active
-  std::vector<double> var_;      // its variance [m^2], for active tactels
-  std::vector<double> plug_in_;  // the plug-in correction [m], for active tactels
-  // The refined correction's workspace: an active tactel, its pad coordinates (pitch units from
-  // the pad centre), measured depth [m] and Jensen factor h v / (2 sigma) [m].
+  std::vector<double> bias_;  // truncation bias by reading count [m]
+  // An active tactel: its cell in the padded grid, pad coordinates (pitch units from the pad
+  // centre), measured depth [m], Jensen factor h v / (2 sigma) of the refined correction [m],
+  // corrected depth's variance [m^2], plug-in correction [m] and reading.
   struct Active {
-    std::size_t index;
-    double x, y, measured, jensen;
+    std::size_t at, tactel;
+    double x, y, measured, jensen, var, plug_in, pressure;
   };
-  std::vector<Active> active_;
-  // per_tactel's workspace: depths (0 where inactive) and active flags of the pad with a
-  // border of inactive tactels, (rows + 2) x (cols + 2).
-  mutable std::vector<double> padded_;
-  mutable std::vector<unsigned char> on_;
+  // Per tactel: 1, X, Y, X^2, XY, Y^2, X^3, X^2 Y, X Y^2, Y^3, X^4, X^3 Y, X^2 Y^2, X Y^3, Y^4
+  // (X, Y its pad coordinates in pitch units) and a zero: the normal matrix of a quadric fit is
+  // a sum of these.
+  std::vector<std::array<double, 16>> monomials_;
+  std::vector<Active> active_;  // the first active_count_ are this frame's, row-major
+  std::vector<std::uint32_t> listed_;  // extract's workspace: indices of the active tactels
+  std::vector<std::size_t> cell_;      // per tactel, its cell in the padded grid
+  std::size_t active_count_ = 0;
+  // The Cholesky factor of this frame's quadric normal matrix, when the refined correction
+  // made it (factored_).
+  double factor_[36] = {}, factor_inv_diag_[6] = {};
+  bool factored_ = false;
+  // The corrected depths [m] (0 where inactive) and active flags of the pad with a border of
+  // inactive tactels, (rows + 2) x (cols + 2).
+  std::vector<double> padded_;
+  std::vector<unsigned char> on_;
 
   // The plane fit of step 2 for one pattern of active neighbours (bit 3 (dr + 1) + (dc + 1) of
-  // the 3x3 neighbourhood, the centre always set): the slopes in pitch units are
-  // sum_k wx[k] d_k and sum_k wy[k] d_k, and their variances (depth variance) * f / pitch^2,
-  // f < 0 meaning not measured (the fallback variance).
+  // the 3x3 neighbourhood, the centre always set). With S, S_x and S_y the sums of the active
+  // depths, and of them times dc and dr, the slopes in pitch units are x . (S_x, S_y, S) and
+  // y . (S_x, S_y, S), and their variances (depth variance) * f / pitch^2, f < 0 meaning not
+  // measured (the fallback variance). 64 bytes a pattern, 32 KiB in all.
   struct PlaneWeights {
-    double wx[9], wy[9];
+    double x[3], y[3];
     double fx, fy;
   };
   static const std::array<PlaneWeights, 512>& plane_weights() {
@@ -513,26 +555,32 @@ class ContactExtractor {
         }
         w.fx = w.fy = -1.0;
         if (n == 0) continue;
+        // Centred: c_xd = S_x - mx S, c_yd = S_y - my S; the slopes solve C g = (c_xd, c_yd).
         const double mx = sx / n, my = sy / n;
         const double cxx = sxx - sx * mx, cyy = syy - sy * my, cxy = sxy - sx * my;
         const double det = cxx * cyy - cxy * cxy;
         constexpr double kTiny = 1e-9;
-        for (int k = 0; k < 9; ++k) {
-          if (!(mask >> k & 1u)) continue;
-          const double ux = k % 3 - 1 - mx, uy = k / 3 - 1 - my;
-          if (cxx > kTiny && cyy > kTiny && det > 0.1 * cxx * cyy) {
-            w.wx[k] = (cyy * ux - cxy * uy) / det;
-            w.wy[k] = (cxx * uy - cxy * ux) / det;
-            w.fx = cyy / det;
-            w.fy = cxx / det;
-          } else if (cxx > kTiny && std::abs(cxy) <= kTiny) {  // a row: x slope only
-            w.wx[k] = ux / cxx;
-            w.fx = 1.0 / cxx;
-          } else if (cyy > kTiny && std::abs(cxy) <= kTiny) {  // a column: y slope only
-            w.wy[k] = uy / cyy;
-            w.fy = 1.0 / cyy;
-          }
+        double ax = 0, bx = 0, ay = 0, by = 0;  // g_x = ax c_xd + bx c_yd, g_y = ay c_xd + by c_yd
+        if (cxx > kTiny && cyy > kTiny && det > 0.1 * cxx * cyy) {
+          ax = cyy / det;
+          bx = -cxy / det;
+          ay = -cxy / det;
+          by = cxx / det;
+          w.fx = cyy / det;
+          w.fy = cxx / det;
+        } else if (cxx > kTiny && std::abs(cxy) <= kTiny) {  // a row: x slope only
+          ax = 1.0 / cxx;
+          w.fx = 1.0 / cxx;
+        } else if (cyy > kTiny && std::abs(cxy) <= kTiny) {  // a column: y slope only
+          by = 1.0 / cyy;
+          w.fy = 1.0 / cyy;
         }
+        w.x[0] = ax;
+        w.x[1] = bx;
+        w.x[2] = -(ax * mx + bx * my);
+        w.y[0] = ay;
+        w.y[1] = by;
+        w.y[2] = -(ay * mx + by * my);
       }
       return t;
     }();
