@@ -127,7 +127,8 @@ class ContactExtractor {
         bias_[static_cast<std::size_t>(k)] = b;
       }
     }
-    const std::size_t tactels = static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols;
+    const std::size_t tactels =
+        static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols;
     active_.resize(tactels);
     listed_.resize(tactels);
     cell_.resize(tactels);
@@ -140,11 +141,24 @@ class ContactExtractor {
     monomials_.resize(tactels);
     for (int r = 0; r < model_.geometry.rows; ++r) {
       for (int c = 0; c < model_.geometry.cols; ++c) {
-        const double X = c - 0.5 * (model_.geometry.cols - 1), Y = r - 0.5 * (model_.geometry.rows - 1);
-        monomials_[static_cast<std::size_t>(r) * model_.geometry.cols + c] = {
-            1.0,       X,         Y,         X * X,         X * Y,         Y * Y,
-            X * X * X, X * X * Y, X * Y * Y, Y * Y * Y,     X * X * X * X, X * X * X * Y,
-            X * X * Y * Y, X * Y * Y * Y, Y * Y * Y * Y, 0.0};
+        const double X = c - 0.5 * (model_.geometry.cols - 1),
+                     Y = r - 0.5 * (model_.geometry.rows - 1);
+        monomials_[static_cast<std::size_t>(r) * model_.geometry.cols + c] = {1.0,
+                                                                              X,
+                                                                              Y,
+                                                                              X * X,
+                                                                              X * Y,
+                                                                              Y * Y,
+                                                                              X * X * X,
+                                                                              X * X * Y,
+                                                                              X * Y * Y,
+                                                                              Y * Y * Y,
+                                                                              X * X * X * X,
+                                                                              X * X * X * Y,
+                                                                              X * X * Y * Y,
+                                                                              X * Y * Y * Y,
+                                                                              Y * Y * Y * Y,
+                                                                              0.0};
       }
     }
     padded_.assign(static_cast<std::size_t>(model_.geometry.rows + 2) * (model_.geometry.cols + 2),
@@ -219,7 +233,6 @@ class ContactExtractor {
   const ContactOptions& options() const noexcept { return options_; }
 
  private:
-
   double depth_variance() const {
     const double dq = model_.depth_per_count();
     return model_.sigma_normal * model_.sigma_normal + dq * dq / 12.0;
@@ -229,8 +242,8 @@ class ContactExtractor {
   // variance along the normal and the slope variances of that normal.
   template <class = void>
   void make(std::vector<Contact<double>>& out, const Eigen::Isometry3d& T, double x, double y,
-            double depth, const Vec3d& n_pad, double var_along, double var_across,
-            double slope_var, double pressure, double time) const {
+            double depth, const Vec3d& n_pad, double var_along, double var_across, double slope_var,
+            double pressure, double time) const {
     const double lever2 = x * x + y * y;
     const double st2 = model_.sigma_tilt * model_.sigma_tilt;
     const double sp2 = model_.sigma_position * model_.sigma_position;
@@ -515,7 +528,7 @@ class ContactExtractor {
   // (X, Y its pad coordinates in pitch units) and a zero: the normal matrix of a quadric fit is
   // a sum of these.
   std::vector<std::array<double, 16>> monomials_;
-  std::vector<Active> active_;  // the first active_count_ are this frame's, row-major
+  std::vector<Active> active_;         // the first active_count_ are this frame's, row-major
   std::vector<std::uint32_t> listed_;  // extract's workspace: indices of the active tactels
   std::vector<std::size_t> cell_;      // per tactel, its cell in the padded grid
   std::size_t active_count_ = 0;
