@@ -143,22 +143,11 @@ class ContactExtractor {
       for (int c = 0; c < model_.geometry.cols; ++c) {
         const double X = c - 0.5 * (model_.geometry.cols - 1),
                      Y = r - 0.5 * (model_.geometry.rows - 1);
-        monomials_[static_cast<std::size_t>(r) * model_.geometry.cols + c] = {1.0,
-                                                                              X,
-                                                                              Y,
-                                                                              X * X,
-                                                                              X * Y,
-                                                                              Y * Y,
-                                                                              X * X * X,
-                                                                              X * X * Y,
-                                                                              X * Y * Y,
-                                                                              Y * Y * Y,
-                                                                              X * X * X * X,
-                                                                              X * X * X * Y,
-                                                                              X * X * Y * Y,
-                                                                              X * Y * Y * Y,
-                                                                              Y * Y * Y * Y,
-                                                                              0.0};
+        const double X2 = X * X, Y2 = Y * Y;
+        monomials_[static_cast<std::size_t>(r) * model_.geometry.cols + c] = {
+            1.0,     X,          Y,       X2,         X * Y,   Y2,
+            X2 * X,  X2 * Y,     X * Y2,  Y2 * Y,  //
+            X2 * X2, X2 * X * Y, X2 * Y2, X * Y2 * Y, Y2 * Y2, 0.0};
       }
     }
     padded_.assign(static_cast<std::size_t>(model_.geometry.rows + 2) * (model_.geometry.cols + 2),
