@@ -278,19 +278,29 @@ int main(int argc, char** argv) try {
   // `threads` threads; each writes only its own slot, and the slots are printed in order, so
   // the output does not depend on the thread count. The heaviest jobs go first.
   std::vector<std::function<void()>> jobs;
-  Study curve;
-  std::vector<Contact<double>> curve_stream;  // sphere r40, both pads: the curve's stream
+  // The error curve on three streams (seeds), each checkpoint of each a job.
+  constexpr std::uint64_t kCurveSeeds[] = {3, 4, 5};
+  constexpr std::size_t kCurves = std::size(kCurveSeeds);
+  std::vector<Study> curves(kCurves);
+  std::vector<std::vector<Contact<double>>> curve_streams(kCurves);  // sphere r40, both pads
   std::vector<std::size_t> checkpoints;
   for (std::size_t k = n / 64; k <= n; k *= 2) checkpoints.push_back(k);
-  for (auto* v : {&curve.contacts, &curve.raw, &curve.average, &curve.kalman, &curve.surfel,
-                  &curve.average3, &curve.kalman3, &curve.surfel3}) {
-    v->assign(checkpoints.size(), 0.0);
+  for (std::size_t c = 0; c < kCurves; ++c) {
+    Study& curve = curves[c];
+    for (auto* v : {&curve.contacts, &curve.raw, &curve.average, &curve.kalman, &curve.surfel,
+                    &curve.average3, &curve.kalman3, &curve.surfel3}) {
+      v->assign(checkpoints.size(), 0.0);
+    }
+    sim::SlidingConfig noise = aniso;
+    noise.seed = kCurveSeeds[c];
+    curve_streams[c] = study_stream(sim::Sphere(0.04), n, noise, true);
   }
-  curve_stream = study_stream(sim::Sphere(0.04), n, aniso, true);
   for (std::size_t i = checkpoints.size(); i-- > 0;) {
-    jobs.emplace_back([&, i] {
-      curve_point(sim::Sphere(0.04), curve_stream, checkpoints[i], kRadius, curve, i);
-    });
+    for (std::size_t c = 0; c < kCurves; ++c) {
+      jobs.emplace_back([&, i, c] {
+        curve_point(sim::Sphere(0.04), curve_streams[c], checkpoints[i], kRadius, curves[c], i);
+      });
+    }
   }
   std::vector<std::string> tables(8);
   const auto table = [&](std::size_t slot, const char* name, const auto& shape,
@@ -376,8 +386,20 @@ int main(int argc, char** argv) try {
       "removes the sag with the curvature it fits to the contacts' normals.\n\n",
       surfel_wins, pads.size());
 
+  // The mean over the seeds of every series.
+  Study curve = curves[0];
+  for (auto member : {&Study::raw, &Study::average, &Study::kalman, &Study::surfel,
+                      &Study::average3, &Study::kalman3, &Study::surfel3}) {
+    for (std::size_t k = 0; k < checkpoints.size(); ++k) {
+      double sum = 0;
+      for (const Study& c : curves) sum += (c.*member)[k];
+      (curve.*member)[k] = sum / double(kCurves);
+    }
+  }
   io::LinePlot plot;
-  plot.title = "RMS distance to the surface against contacts (sphere r40, anisotropic noise)";
+  plot.title =
+      "RMS distance to the surface against contacts (sphere r40, anisotropic noise, mean of 3 "
+      "seeds)";
   plot.x_label = "contacts (thousands)";
   plot.y_label = "RMS error (mm)";
   plot.y_min = 0.0;
@@ -391,11 +413,11 @@ int main(int argc, char** argv) try {
   }
   io::write_file((out / "error_vs_contacts.svg").string(), io::render_svg(plot));
   std::printf(
-      "RMS error [mm] against contacts (sphere r40, both pads): every point | confident points, "
-      "to_point_cloud({3, inf, 0.3e-3}): at least 3 contacts and a standard deviation across the "
-      "surface of at most 0.3 mm (a noise-tail contact of the palm pad, 3-4 sigma = 5 mm out, "
-      "starts a point of its own; such points grow with the stream, and the filter leaves them "
-      "out until finer contacts confirm them)\n");
+      "RMS error [mm] against contacts (sphere r40, both pads; mean of the streams of seeds 3, 4 "
+      "and 5): every point | confident points, to_point_cloud({3, inf, 0.3e-3}): at least 3 "
+      "contacts and a standard deviation across the surface of at most 0.3 mm (a noise-tail "
+      "contact of the palm pad, 3-4 sigma = 5 mm out, starts a point of its own; such points grow "
+      "with the stream, and the filter leaves them out until finer contacts confirm them)\n");
   std::printf("%-10s %9s | %9s %9s %9s | %9s %9s %9s\n", "contacts", "raw", "average", "kalman",
               "surfel", "average", "kalman", "surfel");
   for (std::size_t k = 0; k < curve.contacts.size(); ++k) {
@@ -403,6 +425,22 @@ int main(int argc, char** argv) try {
                 curve.raw[k], curve.average[k], curve.kalman[k], curve.surfel[k], curve.average3[k],
                 curve.kalman3[k], curve.surfel3[k]);
   }
+  // Each seed's confident Surfel series, and its largest rise over an earlier checkpoint.
+  const auto largest_rise = [](const std::vector<double>& v) {
+    double rise = 0, lowest = v.empty() ? 0.0 : v[0];
+    for (const double x : v) {
+      rise = std::max(rise, x / lowest - 1.0);
+      lowest = std::min(lowest, x);
+    }
+    return rise;
+  };
+  for (std::size_t c = 0; c < kCurves; ++c) {
+    std::printf("seed %d, surfel, confident points:", int(kCurveSeeds[c]));
+    for (const double x : curves[c].surfel3) std::printf(" %.3f", x);
+    std::printf("  (largest rise over an earlier checkpoint %+.0f %%)\n",
+                100.0 * largest_rise(curves[c].surfel3));
+  }
+  std::printf("mean of the seeds: largest rise %+.0f %%\n", 100.0 * largest_rise(curve.surfel3));
   std::printf("wrote %s/*.ply and %s/error_vs_contacts.svg\n", out.c_str(), out.c_str());
   return 0;
 } catch (const std::exception& e) {
