@@ -92,20 +92,11 @@ inline std::vector<Vec3d> points_from(const ArrayD& a, const char* what) {
   return out;
 }
 
-/// Why the row-major 4x4 matrix at `m` is not a rigid transform (finite, last row (0, 0, 0, 1),
-/// an orthonormal rotation with determinant +1 to 1e-6), or nullptr when it is; `t` receives it.
+/// The row-major 4x4 matrix at `m` into `t`, and why it is not a rigid transform
+/// (taxel::rigid_defect), or nullptr when it is.
 inline const char* rigid_defect(const double* m, Isometry3d& t) {
-  const Eigen::Matrix4d a = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(m);
-  if (!a.allFinite()) return "the matrix is not finite";
-  if ((a.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > 1e-9) {
-    return "the last row must be (0, 0, 0, 1)";
-  }
-  const Mat3d r = a.topLeftCorner<3, 3>();
-  if ((r.transpose() * r - Mat3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || r.determinant() < 0) {
-    return "the upper-left 3x3 block is not a rotation";
-  }
-  t.matrix() = a;
-  return nullptr;
+  t.matrix() = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(m);
+  return taxel::rigid_defect(t);
 }
 
 /// A 4x4 homogeneous matrix as an isometry; ValueError naming `what` unless it is rigid.

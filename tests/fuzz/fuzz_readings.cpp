@@ -34,7 +34,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           const auto stack = taxel::sensor::ReadingStack::from_npy(a);
           std::vector<taxel::io::PadPose> poses;
           for (std::size_t f = 0; f < stack.frames; ++f)
-            for (std::size_t p = 0; p < stack.pads; ++p) poses.push_back({f, p, 0.0, {}});
+            for (std::size_t p = 0; p < stack.pads; ++p) {
+              poses.push_back({f, p, 0.0, Eigen::Isometry3d::Identity()});
+            }
           taxel::sensor::SensorModel m;
           m.geometry.rows = static_cast<int>(stack.rows);
           m.geometry.cols = static_cast<int>(stack.cols);

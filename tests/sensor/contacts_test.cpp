@@ -306,6 +306,28 @@ TEST_CASE("readings to contacts: bad input is refused", "[sensor]") {
   Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
   bad.translation().x() = std::nan("");
   CHECK_THROWS_WITH(ex.extract(tsn::PadMatrix::Zero(14, 6), bad, 0, out), Contains("not finite"));
+  // A pose that is finite but not rigid would place the contacts wrongly (or, enormous, out of
+  // range): scaled, reflected, a wrong last row, a translation beyond 1e150.
+  const tsn::PadMatrix touched = tsn::PadMatrix::Constant(14, 6, 500);
+  Eigen::Isometry3d scaled = Eigen::Isometry3d::Identity();
+  scaled.linear() *= 1.01;
+  Eigen::Isometry3d mirrored = Eigen::Isometry3d::Identity();
+  mirrored.linear()(2, 2) = -1;
+  Eigen::Isometry3d last_row = Eigen::Isometry3d::Identity();
+  last_row.matrix()(3, 0) = 0.5;
+  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
+  far.translation().x() = 1e200;
+  CHECK_THROWS_WITH(ex.extract(touched, scaled, 0, out), Contains("not a rotation"));
+  CHECK_THROWS_WITH(ex.extract(touched, mirrored, 0, out), Contains("not a rotation"));
+  CHECK_THROWS_WITH(ex.extract(touched, last_row, 0, out), Contains("last row"));
+  CHECK_THROWS_WITH(ex.extract(touched, far, 0, out), Contains("translation"));
+  CHECK(out.empty());
+  // A rotation within rounding of orthonormal, as forward kinematics gives, is accepted.
+  Eigen::Isometry3d fk = Eigen::Isometry3d::Identity();
+  fk.linear() = Eigen::AngleAxisd(1.0, Vec3d(1, 2, 3).normalized()).matrix() * (1.0 + 1e-9);
+  fk.translation() = Vec3d(0.3, -0.2, 0.1);
+  CHECK(ex.extract(touched, fk, 0, out) == 84);
+  out.clear();
   CHECK_THROWS_WITH(tsn::ContactExtractor(tsn::SensorModel{}, {.fallback_normal_sigma = 0}),
                     Contains("fallback_normal_sigma"));
   tsn::SensorModel wrong;

@@ -40,4 +40,28 @@ template <class Derived>
   return ok;
 }
 
+/// Why `T` is not a rigid transform, or nullptr when it is: every entry finite, the last row
+/// (0, 0, 0, 1) to 1e-9, the upper-left 3x3 block a rotation (orthonormal to 1e-6, determinant
+/// positive) and the translation within 1e150 (so that the points it moves stay finite). A
+/// pose from forward kinematics or a pose file passes; a scaled, sheared, reflected or
+/// uninitialised matrix does not.
+template <Scalar S>
+[[nodiscard]] const char* rigid_defect(const Isometry3<S>& T) noexcept {
+  const auto& m = T.matrix();
+  if (!all_finite(m)) return "the matrix is not finite";
+  if (std::abs(m(3, 0)) > S(1e-9) || std::abs(m(3, 1)) > S(1e-9) || std::abs(m(3, 2)) > S(1e-9) ||
+      std::abs(m(3, 3) - S(1)) > S(1e-9)) {
+    return "the last row must be (0, 0, 0, 1)";
+  }
+  const Mat3<S> r = m.template topLeftCorner<3, 3>();
+  if (!((r.transpose() * r - Mat3<S>::Identity()).cwiseAbs().maxCoeff() <= S(1e-6)) ||
+      !(r.determinant() > S(0))) {
+    return "the upper-left 3x3 block is not a rotation";
+  }
+  if (!(m.template topRightCorner<3, 1>().cwiseAbs().maxCoeff() <= S(1e150))) {
+    return "the translation is beyond 1e150";
+  }
+  return nullptr;
+}
+
 }  // namespace taxel

@@ -167,7 +167,7 @@ class ContactExtractor {
   /// Appends the contacts of `counts` (rows x cols readings) taken with the pad at
   /// `T_world_pad` (pad -> world, as the robot believes it) at `time` [s] to `out`, in row-major
   /// tactel order. Returns the number appended. Throws std::invalid_argument when `counts`
-  /// does not match the pad geometry or the pose is not finite.
+  /// does not match the pad geometry or the pose is not a rigid transform (rigid_defect).
   template <class = void>
   std::size_t extract(const PadMatrix& counts, const Eigen::Isometry3d& T_world_pad, double time,
                       std::vector<Contact<double>>& out) {
@@ -178,8 +178,10 @@ class ContactExtractor {
                                   std::to_string(counts.cols()) + ", the pad is " +
                                   std::to_string(g.rows) + " x " + std::to_string(g.cols));
     }
-    if (!T_world_pad.matrix().allFinite()) {
-      throw std::invalid_argument("ContactExtractor: the pad pose is not finite");
+    if (const char* why = rigid_defect(T_world_pad)) {
+      throw std::invalid_argument(std::string("ContactExtractor: the pad pose is not a rigid "
+                                              "transform: ") +
+                                  why);
     }
     // The previous frame's active cells back to inactive, the list of active tactels by a
     // branch-free pass over the readings, then their plug-in depths into the padded grid.
@@ -247,7 +249,7 @@ class ContactExtractor {
     Mat3d cov;
     cov << vt + dv * n.x() * n.x(), cxy, cxz, cxy, vt + dv * n.y() * n.y(), cyz, cxz, cyz,
         vt + dv * n.z() * n.z();
-    out.emplace_back(T * Vec3d(x, y, -depth), cov, n, pressure, time);
+    out.push_back(Contact<double>{T * Vec3d(x, y, -depth), cov, n, pressure, time});
   }
 
   template <class = void>

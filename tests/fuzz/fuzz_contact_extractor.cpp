@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: MIT
+// Fuzzes sensor::ContactExtractor, differentially: the first bytes pick the pad size (1-16 x
+// 1-16), the levels, the threshold, the mode and the options; the rest are frames of readings
+// (two bytes a tactel, any value, saturated and above the levels included). Every frame goes
+// through one extractor, which keeps its workspace from frame to frame, and through a new one:
+// the contacts must be the same bits, and every contact valid (finite, symmetric positive
+// definite covariance, unit normal). Nothing may throw: the readings always fit the pad.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <taxel/core/contact.hpp>
+#include <taxel/sensor/contacts.hpp>
+#include <vector>
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 6) return 0;
+  namespace tsn = taxel::sensor;
+  tsn::SensorModel m;
+  m.geometry.rows = 1 + data[0] % 16;
+  m.geometry.cols = 1 + data[1] % 16;
+  m.levels = 2 + (data[2] | (data[3] & 0x0f) << 8);  // 2 .. 4097
+  m.threshold = 1 + data[4] % (m.levels - 1);
+  m.sigma_normal = (data[5] & 0x10) ? 0.0 : 0.3e-3;
+  const tsn::ContactOptions opt{
+      .mode = (data[5] & 1) ? tsn::ContactMode::per_pad : tsn::ContactMode::per_tactel,
+      .local_normals = (data[5] & 2) != 0,
+      .correct_censoring = (data[5] & 4) != 0,
+      .refine_censoring = (data[5] & 8) != 0};
+  tsn::ContactExtractor reused(m, opt);
+  const std::size_t tactels = static_cast<std::size_t>(m.geometry.rows) * m.geometry.cols;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = Eigen::AngleAxisd(0.3, taxel::Vec3d(1, 2, 3).normalized()).matrix();
+  std::vector<taxel::Contact<double>> a, b;
+  for (std::size_t at = 6; at + 2 * tactels <= size; at += 2 * tactels) {
+    tsn::PadMatrix counts(m.geometry.rows, m.geometry.cols);
+    for (std::size_t i = 0; i < tactels; ++i) {
+      // Values spread over the levels, with 0, the threshold and saturation common.
+      const unsigned v = data[at + 2 * i] | data[at + 2 * i + 1] << 8;
+      counts.data()[i] = static_cast<std::uint16_t>(v % (m.levels + 2));
+    }
+    a.clear();
+    b.clear();
+    const std::size_t n = reused.extract(counts, pose, 0.0, a);
+    tsn::ContactExtractor fresh(m, opt);
+    if (fresh.extract(counts, pose, 0.0, b) != n || a.size() != n || b.size() != n) std::abort();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (std::memcmp(a[i].position.data(), b[i].position.data(), 3 * sizeof(double)) != 0 ||
+          std::memcmp(a[i].covariance.data(), b[i].covariance.data(), 9 * sizeof(double)) != 0 ||
+          std::memcmp(a[i].normal->data(), b[i].normal->data(), 3 * sizeof(double)) != 0) {
+        std::abort();
+      }
+      if (taxel::check_contact(a[i]) != taxel::ContactDefect::ok) std::abort();
+    }
+  }
+  return 0;
+}
