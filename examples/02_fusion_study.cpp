@@ -425,7 +425,9 @@ int main(int argc, char** argv) try {
       "and 5): every point | confident points, to_point_cloud({3, inf, 0.3e-3}): at least 3 "
       "contacts and a standard deviation across the surface of at most 0.3 mm (a noise-tail "
       "contact of the palm pad, 3-4 sigma = 5 mm out, starts a point of its own; such points grow "
-      "with the stream, and the filter leaves them out until finer contacts confirm them)\n");
+      "with the stream, and the filter leaves them out until finer contacts, or about 25 palm "
+      "contacts, have shrunk their covariance: points only the palm has touched then pass while "
+      "still 0.3-0.5 mm off, as one frame's contacts share its pose error)\n");
   std::printf("%-10s %9s | %9s %9s %9s | %9s %9s %9s\n", "contacts", "raw", "average", "kalman",
               "surfel", "average", "kalman", "surfel");
   for (std::size_t k = 0; k < curve.contacts.size(); ++k) {

@@ -62,7 +62,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -442,7 +441,8 @@ class ContactExtractor {
       for (int a = 0; a < 6; ++a) sol[a] += row[a] * d;
     }
     detail_solve(l, 6, inv_l, sol);
-    double e0[6] = {1.0, xc, yc, xc * xc, xc * yc, yc * yc};  // d/d(1, X, Y) of the rows
+    // The row at the centroid, and its derivatives along X and Y.
+    double e0[6] = {1.0, xc, yc, xc * xc, xc * yc, yc * yc};
     double ex[6] = {0.0, 1.0, 0.0, 2.0 * xc, yc, 0.0};
     double ey[6] = {0.0, 0.0, 1.0, 0.0, xc, 2.0 * yc};
     double fit[3] = {}, inv_diag[3];
@@ -508,9 +508,10 @@ class ContactExtractor {
   SensorModel model_;
   ContactOptions options_;
   std::vector<double> bias_;  // truncation bias by reading count [m]
-  // An active tactel: its cell in the padded grid, pad coordinates (pitch units from the pad
-  // centre), measured depth [m], Jensen factor h v / (2 sigma) of the refined correction [m],
-  // corrected depth's variance [m^2], plug-in correction [m] and reading.
+  // An active tactel: its cell in the padded grid, its index, pad coordinates (pitch units from
+  // the pad centre; monomials_ has them too, kept here beside the rest of what the loops read),
+  // measured depth [m], Jensen factor h v / (2 sigma) of the refined correction [m], corrected
+  // depth's variance [m^2], plug-in correction [m] and reading.
   struct Active {
     std::size_t at, tactel;
     double x, y, measured, jensen, var, plug_in, pressure;
