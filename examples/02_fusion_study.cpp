@@ -261,9 +261,9 @@ int main(int argc, char** argv) try {
   // normal, quantisation over a 3.4 mm tactel across it, 0.98 mm) and a palm pad (1.5 mm along
   // the normal, 5 mm tactels: 1.44 mm across), both with 0.15 rad of kinematic tilt. Where the
   // slides overlap, Kalman weighs each contact by its own covariance; averaging cannot. The
-  // association radius is 6 mm, about 4 sigma of the palm pad's noise: a gate near the noise
-  // level lets noise tails start points of their own that then gather more tail contacts, a
-  // selection bias that leaves fused points farther from the surface than the raw contacts.
+  // association radius is 6 mm; the palm pad's contacts get a 9 mm gate (ContactCloud's
+  // association_sigmas, 6 sigma of their noise along the normal), so that a noise tail cannot
+  // land beyond every point, start one off the surface and gather more tail contacts there.
   sim::SlidingConfig aniso;
   aniso.sigma_normal = 0.3e-3;
   aniso.sigma_tilt = 0.15;
@@ -423,11 +423,10 @@ int main(int argc, char** argv) try {
   std::printf(
       "RMS error [mm] against contacts (sphere r40, both pads; mean of the streams of seeds 3, 4 "
       "and 5): every point | confident points, to_point_cloud({3, inf, 0.3e-3}): at least 3 "
-      "contacts and a standard deviation across the surface of at most 0.3 mm (a noise-tail "
-      "contact of the palm pad, 3-4 sigma = 5 mm out, starts a point of its own; such points grow "
-      "with the stream, and the filter leaves them out until finer contacts, or about 25 palm "
-      "contacts, have shrunk their covariance: points only the palm has touched then pass while "
-      "still 0.3-0.5 mm off, as one frame's contacts share its pose error)\n");
+      "contacts and a standard deviation across the surface of at most 0.3 mm (a point only the "
+      "palm pad has touched passes after about 25 of its contacts; as the stream grows, such "
+      "points join the confident ones with errors up to that 0.3 mm, while every point's own "
+      "error shrinks)\n");
   std::printf("%-10s %9s | %9s %9s %9s | %9s %9s %9s\n", "contacts", "raw", "average", "kalman",
               "surfel", "average", "kalman", "surfel");
   for (std::size_t k = 0; k < curve.contacts.size(); ++k) {
@@ -435,7 +434,8 @@ int main(int argc, char** argv) try {
                 curve.raw[k], curve.average[k], curve.kalman[k], curve.surfel[k], curve.average3[k],
                 curve.kalman3[k], curve.surfel3[k]);
   }
-  // Each seed's confident Surfel series, and its largest rise over an earlier checkpoint.
+  // Each seed's Surfel series, every point and confident points, and the largest rise of each
+  // over an earlier checkpoint.
   const auto largest_rise = [](const std::vector<double>& v) {
     double rise = 0, lowest = v.empty() ? 0.0 : v[0];
     for (const double x : v) {
@@ -445,12 +445,18 @@ int main(int argc, char** argv) try {
     return rise;
   };
   for (std::size_t c = 0; c < kCurves; ++c) {
-    std::printf("seed %d, surfel, confident points:", int(kCurveSeeds[c]));
-    for (const double x : curves[c].surfel3) std::printf(" %.3f", x);
-    std::printf("  (largest rise over an earlier checkpoint %+.0f %%)\n",
-                100.0 * largest_rise(curves[c].surfel3));
+    for (const auto& [name, series] : {std::pair{"every point", &Study::surfel},
+                                       std::pair{"confident points", &Study::surfel3}}) {
+      std::printf("seed %d, surfel, %-16s:", int(kCurveSeeds[c]), name);
+      for (const double x : curves[c].*series) std::printf(" %.3f", x);
+      std::printf("  (largest rise over an earlier checkpoint %+.0f %%)\n",
+                  100.0 * largest_rise(curves[c].*series));
+    }
   }
-  std::printf("mean of the seeds: largest rise %+.0f %%\n", 100.0 * largest_rise(curve.surfel3));
+  std::printf(
+      "mean of the seeds: largest rise %+.0f %% over every point, %+.0f %% over the "
+      "confident points\n",
+      100.0 * largest_rise(curve.surfel), 100.0 * largest_rise(curve.surfel3));
   std::printf("wrote %s/*.ply and %s/error_vs_contacts.svg\n", out.c_str(), out.c_str());
   return 0;
 } catch (const std::exception& e) {

@@ -63,13 +63,13 @@ int main(int argc, char** argv) try {
   std::filesystem::create_directories(out);
   const sim::Box box(Vec3d(0.04, 0.03, 0.02));
 
-  // The exploration: several slides from random starts, 1 mm noise along the pad normal.
+  // The exploration: several slides from random starts, 0.5 mm noise along the pad normal.
   std::vector<Contact<double>> contacts;
   const int slides = quick ? 5 : 6;
   for (int s = 0; s < slides; ++s) {
     const auto part = sim::sliding_exploration(
         box, quick ? 3000 : 8000,
-        {.speed = 0.08, .sigma_tilt = 0.1, .seed = 11 + static_cast<std::uint64_t>(s)});
+        {.speed = 0.08, .sigma_normal = 0.5e-3, .sigma_tilt = 0.1, .seed = 11 + static_cast<std::uint64_t>(s)});
     contacts.insert(contacts.end(), part.begin(), part.end());
   }
   fusion::ContactCloud<fusion::Kalman<double>, index::VoxelHash<double>> fused(

@@ -56,6 +56,9 @@ options:
                     mean; raw: every contact kept)
   --index voxel-hash|kd-tree|brute-force   spatial index (default voxel-hash)
   --radius R        association radius [m] (default 0.0034, one DSA tactel pitch)
+  --association-sigmas K   widen the gate to K standard deviations of a contact's noise
+                    along its normal when that is larger than R, so that a coarse contact's
+                    noise tail cannot start a point off the surface (default 6; 0: off)
   --gate CHI2       surfel, kalman: Mahalanobis gate (e.g. 11.345 for 99 %; default none)
   --process-noise Q surfel, kalman: process noise [m] per update (default 0)
   --min-observations N   keep only points with at least N contacts (default 1: all)
@@ -97,6 +100,7 @@ struct Options {
   std::string policy = "surfel";
   std::string index = "voxel-hash";
   double radius = 3.4e-3;
+  double association_sigmas = 6.0;
   double gate = 0.0;
   double process_noise = 0.0;
   bool ascii = false;
@@ -135,6 +139,7 @@ template <class Cloud>
 int fuse(const Options& o, typename Cloud::Config cfg,
          const std::vector<taxel::Contact<double>>& contacts, const taxel_cli::Args& args) {
   cfg.association_radius = o.radius;
+  cfg.association_sigmas = o.association_sigmas;
   Cloud cloud(cfg);
   cloud.reserve(contacts.size());
   std::map<std::string, std::size_t> rejected;
@@ -287,6 +292,8 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--radius") {
       o.radius = args.length(-kInf, kInf);
+    } else if (a == "--association-sigmas") {
+      o.association_sigmas = args.number<double>(-kInf, kInf);
     } else if (a == "--gate") {
       o.gate = args.number<double>(-kInf, kInf);
     } else if (a == "--process-noise") {

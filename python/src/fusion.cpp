@@ -22,6 +22,7 @@ using fusion::InsertStatus;
 /// Every option of every policy and index, with the C++ defaults.
 struct CloudOptions {
   double association_radius = 3.4e-3;
+  double association_sigmas = 6.0;
   double process_noise = 0.0;
   std::optional<double> gate_chi2;
   std::optional<double> initial_sigma;
@@ -137,6 +138,7 @@ template <class F, class I>
 std::unique_ptr<CloudBase> make_cloud(const CloudOptions& o) {
   typename fusion::ContactCloud<F, I>::Config cfg;
   cfg.association_radius = o.association_radius;
+  cfg.association_sigmas = o.association_sigmas;
   cfg.fusion = policy_config<F>(o);
   if constexpr (std::is_same_v<I, index::VoxelHash<double>>) {
     cfg.index.max_load_factor = o.max_load_factor;
@@ -365,22 +367,24 @@ Raises ValueError for mismatched shapes, readings above the model's levels and n
   f.attr("INDEXES") = py::make_tuple("voxel_hash", "dynamic_kdtree", "brute_force");
   py::class_<PyContactCloud>(f, "ContactCloud", R"doc(
 A compact cloud of fused contact points (Meier et al. 2011): each contact fuses into the
-nearest point within `association_radius` [m], or starts a new point.
+nearest point within `association_radius` [m], or starts a new point. The gate widens to
+`association_sigmas` standard deviations of a contact's noise along its normal when that is
+larger, so that a coarse contact's noise tail cannot start a point off the surface (0: off).
 
 policy: 'surfel' (default; a Kalman point that removes the chord sag of curved surfaces),
 'kalman' (per-point Kalman filter), 'average' (running mean), 'raw' (every contact kept).
 index: 'voxel_hash' (default), 'dynamic_kdtree' or 'brute_force'.
 Options that the chosen policy or index does not use must stay at their defaults.)doc")
       .def(py::init([](const std::string& policy, const std::string& index,
-                       double association_radius, double process_noise,
+                       double association_radius, double association_sigmas, double process_noise,
                        std::optional<double> gate_chi2, std::optional<double> initial_sigma,
                        std::string average_mode, double alpha, double max_normal_angle,
                        double normal_sigma, double curvature_prior, std::size_t leaf_size,
                        double max_load_factor) {
              const CloudOptions o{
-                 association_radius,      process_noise, gate_chi2,        initial_sigma,
-                 std::move(average_mode), alpha,         max_normal_angle, normal_sigma,
-                 curvature_prior,         leaf_size,     max_load_factor};
+                 association_radius, association_sigmas,      process_noise, gate_chi2,
+                 initial_sigma,      std::move(average_mode), alpha,         max_normal_angle,
+                 normal_sigma,       curvature_prior,         leaf_size,     max_load_factor};
              const int p = enum_from(policy, kPolicies, "policy");
              const int i = enum_from(index, kIndexes, "index");
              check_unused(o, p, i);
@@ -401,12 +405,12 @@ Options that the chosen policy or index does not use must stay at their defaults
              return c;
            }),
            py::arg("policy") = "surfel", py::arg("index") = "voxel_hash", py::kw_only(),
-           py::arg("association_radius") = 3.4e-3, py::arg("process_noise") = 0.0,
-           py::arg("gate_chi2") = py::none(), py::arg("initial_sigma") = py::none(),
-           py::arg("average_mode") = "cumulative", py::arg("alpha") = 0.1,
-           py::arg("max_normal_angle") = 1.2, py::arg("normal_sigma") = 0.05,
-           py::arg("curvature_prior") = 100.0, py::arg("leaf_size") = 10,
-           py::arg("max_load_factor") = 0.25)
+           py::arg("association_radius") = 3.4e-3, py::arg("association_sigmas") = 6.0,
+           py::arg("process_noise") = 0.0, py::arg("gate_chi2") = py::none(),
+           py::arg("initial_sigma") = py::none(), py::arg("average_mode") = "cumulative",
+           py::arg("alpha") = 0.1, py::arg("max_normal_angle") = 1.2,
+           py::arg("normal_sigma") = 0.05, py::arg("curvature_prior") = 100.0,
+           py::arg("leaf_size") = 10, py::arg("max_load_factor") = 0.25)
       .def_readonly("policy", &PyContactCloud::policy)
       .def_readonly("index", &PyContactCloud::index)
       .def_readonly("association_radius", &PyContactCloud::association_radius)

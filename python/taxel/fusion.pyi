@@ -18,13 +18,15 @@ import taxel.sim
 
 class ContactCloud:
     """A compact cloud of fused contact points (Meier et al. 2011): each contact fuses into the
-nearest point within `association_radius` [m], or starts a new point.
+nearest point within `association_radius` [m], or starts a new point. The gate widens to
+`association_sigmas` standard deviations of a contact's noise along its normal when that is
+larger, so that a coarse contact's noise tail cannot start a point off the surface (0: off).
 
 policy: 'surfel' (default; a Kalman point that removes the chord sag of curved surfaces),
 'kalman' (per-point Kalman filter), 'average' (running mean), 'raw' (every contact kept).
 index: 'voxel_hash' (default), 'dynamic_kdtree' or 'brute_force'.
 Options that the chosen policy or index does not use must stay at their defaults."""
-    def __init__(self, policy: str = 'surfel', index: str = 'voxel_hash', *, association_radius: float = 0.0034, process_noise: float = 0.0, gate_chi2: typing.Optional[float] = None, initial_sigma: typing.Optional[float] = None, average_mode: str = 'cumulative', alpha: float = 0.1, max_normal_angle: float = 1.2, normal_sigma: float = 0.05, curvature_prior: float = 100.0, leaf_size: int = 10, max_load_factor: float = 0.25) -> None: ...
+    def __init__(self, policy: str = 'surfel', index: str = 'voxel_hash', *, association_radius: float = 0.0034, association_sigmas: float = 6.0, process_noise: float = 0.0, gate_chi2: typing.Optional[float] = None, initial_sigma: typing.Optional[float] = None, average_mode: str = 'cumulative', alpha: float = 0.1, max_normal_angle: float = 1.2, normal_sigma: float = 0.05, curvature_prior: float = 100.0, leaf_size: int = 10, max_load_factor: float = 0.25) -> None: ...
     def __len__(self) -> int: ...
     def __repr__(self) -> str: ...
     @property

@@ -435,6 +435,11 @@ TEST_CASE("ContactCloud rejects bad configuration naming the field", "[fusion]")
                     Contains("association_radius = 4.000000 m looks like millimetres") &&
                         Contains("4.000000 mm = 0.004000"));
   CHECK_NOTHROW(tf::ContactCloud<>({.association_radius = 1.0}));
+  for (const double k : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    CHECK_THROWS_WITH(tf::ContactCloud<>({.association_sigmas = k}),
+                      Contains("association_sigmas"));
+  }
+  CHECK_NOTHROW(tf::ContactCloud<>({.association_sigmas = 0}));
   CHECK_THROWS_WITH(KalmanCloud({.fusion = {.process_noise = -1}}), Contains("process_noise"));
   CHECK_THROWS_WITH(KalmanCloud({.fusion = {.gate_chi2 = 0.0}}), Contains("gate_chi2"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.kalman = {.process_noise = -1}}}),
@@ -632,6 +637,62 @@ TEST_CASE("Surfel fits the curvature of a cylinder patch", "[fusion]") {
   CHECK(h[0] + h[2] == Approx(1 / R).epsilon(0.03));
   CHECK(std::abs(h[0] * h[2] - h[1] * h[1]) < 0.05 / (R * R));
   CHECK(std::abs(surfel.mean(s).head<2>().norm() - R) < 5e-6);
+}
+
+TEST_CASE("the association gate widens to association_sigmas of a coarse contact's noise",
+          "[fusion][gate]") {
+  using Cloud = tf::ContactCloud<tf::Surfel<double>>;
+  const taxel::Vec3d up(0, 0, 1);
+  // A fine contact (0.3 mm along its normal) and a coarse one (1.5 mm), both 1 mm across.
+  taxel::Contact<double> fine =
+      contact_at<double>({0, 0, 0}, taxel::pad_covariance(up, 0.3e-3, 1e-3));
+  fine.normal = up;
+  taxel::Contact<double> coarse = fine;
+  coarse.covariance = taxel::pad_covariance(up, 1.5e-3, 1e-3);
+  const Cloud cloud({.association_radius = 6e-3});
+  CHECK(cloud.gate(fine) == 6e-3);  // 6 x 0.3 mm is inside the radius
+  CHECK(cloud.gate(coarse) == Approx(9e-3).epsilon(1e-12));
+  // The normal decides, not the trace: the same coarse covariance seen from the side.
+  taxel::Contact<double> side = coarse;
+  side.normal = taxel::Vec3d(1, 0, 0);
+  CHECK(cloud.gate(side) == 6e-3);
+  // Without a normal: the smallest eigenvalue, whatever the axes (a rotated covariance).
+  taxel::Contact<double> bare = coarse;
+  bare.normal.reset();
+  const taxel::Mat3d rot =
+      Eigen::AngleAxisd(0.7, taxel::Vec3d(1, 2, 3).normalized()).toRotationMatrix();
+  bare.covariance = rot * taxel::pad_covariance(up, 2.0e-3, 3e-3) * rot.transpose();
+  CHECK(cloud.gate(bare) == Approx(12e-3).epsilon(1e-9));
+  CHECK(Cloud({.association_radius = 6e-3, .association_sigmas = 0}).gate(coarse) == 6e-3);
+  CHECK(Cloud({.association_radius = 6e-3, .association_sigmas = 3}).gate(coarse) == 6e-3);
+
+  // What the gate is for: coarse contacts on the plane z = 0, noise comparable to the radius.
+  // With a fixed 6 mm gate a 3-4 sigma tail now and then lands beyond every point, starts a
+  // point off the surface, and that point gathers the contacts on its side: it ends up
+  // millimetres off while its covariance claims far less. The widened gate absorbs the tails.
+  const auto run = [&](double sigmas) {
+    std::mt19937_64 rng(21);
+    std::normal_distribution<double> g(0.0, 1.0);
+    std::uniform_real_distribution<double> u(-0.03, 0.03);
+    Cloud c({.association_radius = 6e-3, .association_sigmas = sigmas});
+    for (int i = 0; i < 60000; ++i) {
+      taxel::Contact<double> k = coarse;
+      k.position = {u(rng) + 1.44e-3 * g(rng), u(rng) + 1.44e-3 * g(rng), 1.5e-3 * g(rng)};
+      REQUIRE(c.insert(k).status != tf::InsertStatus::rejected);
+    }
+    // Worst height among the points the confidence filter keeps, in units of their claimed
+    // standard deviation along z.
+    double worst = 0;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const auto id = static_cast<taxel::index::PointId>(i);
+      if (!c.confident(id, {3, std::numeric_limits<double>::infinity(), 0.3e-3})) continue;
+      worst = std::max(worst, std::abs(c.mean(id).z()) / std::sqrt(c.covariance(id)(2, 2)));
+    }
+    return worst;
+  };
+  const double fixed = run(0), widened = run(6);
+  CHECK(fixed > 6);      // tail points: far beyond what their covariance claims
+  CHECK(widened < 4.5);  // every confident point within what its covariance says
 }
 
 TEST_CASE("to_point_cloud: full covariances, normals and confidence filters",

@@ -56,7 +56,11 @@ struct IcpConfig {
   std::size_t coarse_points = 0;
 };
 
-/// The outcome of one alignment. `ok`: converged; `not_converged`: the iteration cap was hit
+/// The outcome of one alignment. `ok`: converged (the update fell below the tolerances, the
+/// RMSE change below relative_error_tolerance, or the iteration returned to the pose it left
+/// one update before, a two-cycle between two sets of correspondences, which point-to-plane
+/// can enter on sparse clouds: then the pose of the two with the lower RMSE); `not_converged`:
+/// the iteration cap was hit
 /// (the last iterate is returned); `degenerate`: the geometry does not fix the pose (too few
 /// points or correspondences, collinear points, or for point-to-plane a plane, sphere or
 /// cylinder patch); transform and RMSE are still those of the last iterate, never NaN;
@@ -357,6 +361,9 @@ class Icp {
   Outcome iterate(const Target<S>& target, Isometry3d& t, std::size_t need, double loosen,
                   int& iterations) {
     double previous_rmse = std::numeric_limits<double>::infinity();
+    Isometry3d back = t;  // the pose the previous update started from, and its RMSE
+    double back_rmse = previous_rmse;
+    bool has_back = false;
     Outcome last{};
     hints_.assign(active_->size(), kNoHint);  // a new stage: no previous matches
     for (int it = 0; it < cfg_.max_iterations; ++it) {
@@ -377,6 +384,7 @@ class Icp {
         return last;  // nothing to apply
       }
       if (!delta.matrix().allFinite()) return {Status::degenerate, "the update is not finite"};
+      const Isometry3d from = t;
       t = delta * t;
       // Re-orthonormalise against drift over many updates.
       t.linear() = Eigen::Quaterniond(t.linear()).normalized().toRotationMatrix();
@@ -386,6 +394,19 @@ class Icp {
           angle <= loosen * cfg_.rotation_tolerance) {
         return last;
       }
+      // Back where the previous update started: the next updates would alternate between the
+      // same two poses until the cap. Keep the better of the two.
+      if (has_back) {
+        const Isometry3d gap = t * back.inverse();
+        if (gap.translation().norm() <= loosen * cfg_.translation_tolerance &&
+            Eigen::AngleAxisd(gap.linear()).angle() <= loosen * cfg_.rotation_tolerance) {
+          t = back_rmse < rmse ? back : from;
+          return last;
+        }
+      }
+      back = from;
+      back_rmse = rmse;
+      has_back = true;
     }
     if (last.status == Status::degenerate) return last;
     return {Status::not_converged,
