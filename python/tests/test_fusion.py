@@ -131,6 +131,29 @@ def test_bad_input_is_refused_with_nothing_inserted():
         fusion.ContactCloud("kalman", alpha=0.5)
 
 
+def test_association_gate_widens_for_coarse_contacts(rng):
+    # Coarse contacts on the plane z = 0: 1.5 mm along the normal (+z), 1.44 mm across it,
+    # against a 6 mm radius. With the radius alone, noise tails start points off the plane
+    # whose covariance claims far less than their height; with the default widened gate
+    # (6 sigma = 9 mm) no confident point is more than a few of its sigmas off.
+    n = 40000
+    pos = np.column_stack([rng.uniform(-0.03, 0.03, (n, 2)), np.zeros(n)])
+    pos += rng.normal(size=(n, 3)) * [1.44e-3, 1.44e-3, 1.5e-3]
+    cov = np.tile(np.diag([1.44e-3**2, 1.44e-3**2, 1.5e-3**2]), (n, 1, 1))
+    normals = np.tile([0.0, 0.0, 1.0], (n, 1))
+    worst = {}
+    for sigmas in (0.0, 6.0):
+        cloud = fusion.ContactCloud(association_radius=6e-3, association_sigmas=sigmas)
+        cloud.insert(pos, cov, normals)
+        keep = cloud.confident(min_observations=3, max_normal_sigma=0.3e-3)
+        z = np.abs(cloud.means[keep, 2]) / np.sqrt(cloud.covariances[keep, 2, 2])
+        worst[sigmas] = z.max()
+    assert worst[0.0] > 6 and worst[6.0] < 4.5
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="association_sigmas"):
+            fusion.ContactCloud(association_sigmas=bad)
+
+
 def test_confidence_filter(rng):
     pos, cov, label = clusters(rng, centres=10, per=5)
     single = np.array([[5.0, 5.0, 5.0]])
