@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -122,7 +123,13 @@ class ContactCloud {
       }
     }
     if constexpr (F::kMerges) {
-      if (const auto hit = index_.nearest_within(contact.position, gate(contact))) {
+      // The nearest point within the radius is the nearest within any wider gate too, so the
+      // wider query runs only when the radius holds none (the index serves the radius best).
+      auto hit = index_.nearest_within(contact.position, config_.association_radius);
+      if (!hit) [[unlikely]] {
+        hit = nearest_within_gate(contact);
+      }
+      if (hit) {
         const index::PointId id = hit->id;
         Point& point = points_[id];
         State fused = point.state;
@@ -341,6 +348,15 @@ class ContactCloud {
     Meta meta;
   };
   std::vector<Point> points_;
+
+  // The nearest point within the widened gate, when it is wider than the radius (out of line:
+  // the common path, a point within the radius, stays short).
+  [[gnu::noinline]] std::optional<index::Neighbor<Scalar>> nearest_within_gate(
+      const Contact<Scalar>& contact) const {
+    const Scalar g = gate(contact);
+    if (!(g > config_.association_radius)) return std::nullopt;
+    return index_.nearest_within(contact.position, g);
+  }
 
   static void check_filter(const PointFilter& filter) {
     if (!(filter.max_sigma >= Scalar(0))) {
