@@ -639,6 +639,25 @@ TEST_CASE("Surfel fits the curvature of a cylinder patch", "[fusion]") {
   CHECK(std::abs(surfel.mean(s).head<2>().norm() - R) < 5e-6);
 }
 
+TEST_CASE("a valid contact whose Surfel weight overflows is refused, not added as NaN",
+          "[fusion]") {
+  // Found by fuzzing: a variance of 1e-320 along the normal is valid (the determinant,
+  // 1e100 * 1e100 * 1e-320, is positive) but its information 1 / n'Rn overflows to infinity.
+  taxel::Contact<double> c = contact_at<double>(
+      {0.01, 0.02, 0.03}, taxel::Vec3d(1e100, 1e100, 1e-320).asDiagonal().toDenseMatrix());
+  c.normal = taxel::Vec3d(0, 0, 1);
+  REQUIRE(taxel::check_contact(c) == taxel::ContactDefect::ok);
+  tf::ContactCloud<> cloud;
+  const auto r = cloud.insert(c);
+  CHECK(r.status == tf::InsertStatus::rejected);
+  CHECK(r.defect == taxel::ContactDefect::overflow);
+  CHECK(cloud.empty());
+  // The same contact without the normal is a plain Kalman point, and finite.
+  c.normal.reset();
+  REQUIRE(cloud.insert(c).status == tf::InsertStatus::added);
+  CHECK(cloud.mean(0).allFinite());
+}
+
 TEST_CASE("the association gate widens to association_sigmas of a coarse contact's noise",
           "[fusion][gate]") {
   using Cloud = tf::ContactCloud<tf::Surfel<double>>;

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Fuzzes ContactCloud::insert with arbitrary contacts (any bit patterns, NaN, Inf, huge,
-// indefinite): it must never crash, reject exactly the invalid ones, and keep every fused
-// point finite.
+// indefinite; with a normal or without) and association gates (association_sigmas from the
+// first byte, so huge covariances widen the gate without bound): it must never crash, reject
+// exactly the invalid ones, and keep every fused point finite.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -9,8 +10,13 @@
 #include <taxel/fusion.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  taxel::fusion::ContactCloud<> cloud({.association_radius = 2e-3});
-  constexpr std::size_t kDoubles = 3 + 6;  // position, upper triangle of the covariance
+  if (size < 1) return 0;
+  const double sigmas = double(data[0] % 16);  // 0 (fixed gate) .. 15
+  ++data;
+  --size;
+  taxel::fusion::ContactCloud<> cloud({.association_radius = 2e-3, .association_sigmas = sigmas});
+  // Position, upper triangle of the covariance, normal (used when its first byte is odd).
+  constexpr std::size_t kDoubles = 3 + 6 + 3;
   while (size >= kDoubles * sizeof(double)) {
     double v[kDoubles];
     std::memcpy(v, data, sizeof v);
@@ -19,10 +25,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     taxel::Contact<double> c;
     c.position = {v[0], v[1], v[2]};
     c.covariance << v[3], v[4], v[5], v[4], v[6], v[7], v[5], v[7], v[8];
+    std::uint8_t flag = 0;
+    std::memcpy(&flag, &v[9], 1);
+    if (flag & 1) {
+      const taxel::Vec3d n(v[9], v[10], v[11]);
+      // Mostly unit normals (a finite, non-zero vector normalised), sometimes the raw bits.
+      c.normal = (flag & 2) && n.allFinite() && n.norm() > 0 ? taxel::Vec3d(n.normalized()) : n;
+    }
     const bool valid = taxel::check_contact(c) == taxel::ContactDefect::ok;
     const std::size_t before = cloud.size();
     const auto r = cloud.insert(c);
     if (!valid && (r.status != taxel::fusion::InsertStatus::rejected || cloud.size() != before)) {
+      std::abort();
+    }
+    // A valid contact is refused only for overflow or a position beyond the index's exact
+    // range, and then leaves the cloud as it was.
+    if (valid && r.status == taxel::fusion::InsertStatus::rejected &&
+        ((r.defect != taxel::ContactDefect::overflow &&
+          r.defect != taxel::ContactDefect::out_of_range) ||
+         cloud.size() != before)) {
       std::abort();
     }
     if (r.status != taxel::fusion::InsertStatus::rejected && !cloud.mean(r.id).allFinite()) {

@@ -149,8 +149,14 @@ class ContactCloud {
     }
     TAXEL_ASSERT(points_.size() < std::numeric_limits<index::PointId>::max(),
                  "ContactCloud: more than 2^32 - 1 points");
+    State state = policy_.init(contact);
+    if (!all_finite(policy_.mean(state)) || !all_finite(policy_.covariance(state))) {
+      // A valid contact whose covariance is near the overflow threshold (a Surfel weight of
+      // 1 / n'Rn underflowing to 0): keep the model intact, as for a fused contact.
+      return {InsertStatus::rejected, 0, ContactDefect::overflow};
+    }
     const auto id = static_cast<index::PointId>(points_.size());
-    points_.push_back({policy_.init(contact), {1, contact.time}});
+    points_.push_back({state, {1, contact.time}});
     index_.insert(id, contact.position);
     return {InsertStatus::added, id, ContactDefect::ok};
   }
