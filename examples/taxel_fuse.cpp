@@ -29,7 +29,8 @@ constexpr const char* kUsage = R"usage(usage: taxel-fuse [options] CONTACTS.csv 
        taxel-fuse [options] --session SESSION.txt [--poses POSES.csv] CLOUD.ply
 
 Fuses a contact stream into a compact cloud: each contact joins the nearest fused point within
-the association radius, or starts a new one. The contacts come from a CSV, or from pad
+the association radius (wider for a contact whose noise along its normal is coarse: see
+--association-sigmas), or starts a new one. The contacts come from a CSV, or from pad
 readings and the pads' poses, turned into contacts by taxel's sensor model (a local surface
 normal from each pad's depth map, the noise floor's censoring removed, the covariance tight
 along that normal; include/taxel/sensor/contacts.hpp).
