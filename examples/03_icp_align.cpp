@@ -67,9 +67,11 @@ int main(int argc, char** argv) try {
   std::vector<Contact<double>> contacts;
   const int slides = quick ? 5 : 6;
   for (int s = 0; s < slides; ++s) {
-    const auto part = sim::sliding_exploration(
-        box, quick ? 3000 : 8000,
-        {.speed = 0.08, .sigma_normal = 0.5e-3, .sigma_tilt = 0.1, .seed = 11 + static_cast<std::uint64_t>(s)});
+    const auto part = sim::sliding_exploration(box, quick ? 3000 : 8000,
+                                               {.speed = 0.08,
+                                                .sigma_normal = 0.5e-3,
+                                                .sigma_tilt = 0.1,
+                                                .seed = 11 + static_cast<std::uint64_t>(s)});
     contacts.insert(contacts.end(), part.begin(), part.end());
   }
   fusion::ContactCloud<fusion::Kalman<double>, index::VoxelHash<double>> fused(
