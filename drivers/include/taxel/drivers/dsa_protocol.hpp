@@ -254,7 +254,11 @@ class Reader {
   std::size_t at_ = 0;
 };
 
-inline void put_bytes(std::vector<std::uint8_t>& out, const void* v, std::size_t n) {
+// Out of line: inlined into the small encoders below, vector::insert draws false
+// -Wstringop-overflow / -Warray-bounds reports from GCC 12 at -O3, depending on what else the
+// translation unit inlines. Speed is no concern here (messages of a few bytes).
+[[gnu::noinline]] inline void put_bytes(std::vector<std::uint8_t>& out, const void* v,
+                                        std::size_t n) {
   const auto* b = static_cast<const std::uint8_t*>(v);
   out.insert(out.end(), b, b + n);
 }
