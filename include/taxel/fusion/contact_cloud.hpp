@@ -151,8 +151,8 @@ class ContactCloud {
                  "ContactCloud: more than 2^32 - 1 points");
     State state = policy_.init(contact);
     if (!all_finite(policy_.mean(state)) || !all_finite(policy_.covariance(state))) {
-      // A valid contact whose covariance is near the overflow threshold (a Surfel weight of
-      // 1 / n'Rn underflowing to 0): keep the model intact, as for a fused contact.
+      // A valid contact with extreme magnitudes (a variance of 1e-320 along the normal makes
+      // Surfel's weight 1 / n'Rn infinite): keep the model intact, as for a fused contact.
       return {InsertStatus::rejected, 0, ContactDefect::overflow};
     }
     const auto id = static_cast<index::PointId>(points_.size());
