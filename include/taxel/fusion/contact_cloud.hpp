@@ -360,7 +360,13 @@ class ContactCloud {
   [[gnu::noinline]] std::optional<index::Neighbor<Scalar>> nearest_within_gate(
       const Contact<Scalar>& contact) const {
     const Scalar g = gate(contact);
-    if (!(g > config_.association_radius)) return std::nullopt;
+    const Scalar r = config_.association_radius;
+    if (!(g > r)) return std::nullopt;
+    // Twice the radius first: a narrower query reads fewer cells, and what it finds is the
+    // nearest within the gate too.
+    if (g > Scalar(2) * r) {
+      if (auto hit = index_.nearest_within(contact.position, Scalar(2) * r)) return hit;
+    }
     return index_.nearest_within(contact.position, g);
   }
 
