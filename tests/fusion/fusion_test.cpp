@@ -285,27 +285,34 @@ TEMPLATE_TEST_CASE("ContactCloud gives identical clouds over every index", "[fus
   const auto stream64 = taxel::sim::sliding_exploration(taxel::sim::Box(), 20000, {.seed = 4});
   std::vector<taxel::Contact<S>> stream;
   for (const auto& c : stream64) stream.push_back(taxel::contact_cast<S>(c));
-  const typename tf::ContactCloud<tf::Kalman<S>>::Config cfg{.association_radius = S(2e-3)};
-
-  tf::ContactCloud<tf::Kalman<S>, ti::BruteForce<S>> brute({cfg.association_radius});
-  tf::ContactCloud<tf::Kalman<S>, ti::VoxelHash<S>> voxel({cfg.association_radius});
-  tf::ContactCloud<tf::Kalman<S>, ti::DynamicKdTree<S>> kd({cfg.association_radius});
-  const std::span<const taxel::Contact<S>> all(stream);
-  const auto rb = brute.insert(all);
-  const auto rv = voxel.insert(all);
-  const auto rk = kd.insert(all);
-  CHECK(rb.added == rv.added);
-  CHECK(rb.added == rk.added);
-  CHECK(rb.fused == rv.fused);
-  CHECK(rb.fused > rb.added);  // the stream is redundant: most contacts fuse
-  REQUIRE(brute.size() == voxel.size());
-  REQUIRE(brute.size() == kd.size());
-  for (ti::PointId i = 0; i < brute.size(); ++i) {
-    REQUIRE(brute.mean(i) == voxel.mean(i));
-    REQUIRE(brute.mean(i) == kd.mean(i));
-    REQUIRE(brute.observations(i) == voxel.observations(i));
-    REQUIRE(brute.covariance(i) == kd.covariance(i));
+  // The stream's 1 mm of noise along the normal widens the 2 mm gate to 6 mm by default
+  // (queries within 4 mm, then 6 mm); association_sigmas = 0 keeps it fixed.
+  std::size_t points[2] = {0, 0};
+  for (const S sigmas : {S(0), S(6)}) {
+    CAPTURE(sigmas);
+    const S r = S(2e-3);
+    tf::ContactCloud<tf::Kalman<S>, ti::BruteForce<S>> brute({r, sigmas});
+    tf::ContactCloud<tf::Kalman<S>, ti::VoxelHash<S>> voxel({r, sigmas});
+    tf::ContactCloud<tf::Kalman<S>, ti::DynamicKdTree<S>> kd({r, sigmas});
+    const std::span<const taxel::Contact<S>> all(stream);
+    const auto rb = brute.insert(all);
+    const auto rv = voxel.insert(all);
+    const auto rk = kd.insert(all);
+    CHECK(rb.added == rv.added);
+    CHECK(rb.added == rk.added);
+    CHECK(rb.fused == rv.fused);
+    CHECK(rb.fused > rb.added);  // the stream is redundant: most contacts fuse
+    REQUIRE(brute.size() == voxel.size());
+    REQUIRE(brute.size() == kd.size());
+    for (ti::PointId i = 0; i < brute.size(); ++i) {
+      REQUIRE(brute.mean(i) == voxel.mean(i));
+      REQUIRE(brute.mean(i) == kd.mean(i));
+      REQUIRE(brute.observations(i) == voxel.observations(i));
+      REQUIRE(brute.covariance(i) == kd.covariance(i));
+    }
+    points[sigmas > S(0) ? 1 : 0] = brute.size();
   }
+  CHECK(points[1] * 5 < points[0]);  // the widened gate is at work: far fewer points
 }
 
 namespace {
