@@ -68,6 +68,15 @@ const std::vector<taxel::Contact<S>>& stream(ShapeId shape) {
   return s;
 }
 
+// Contacts per second (and its inverse, ns per contact) and the points of the last cloud.
+void per_contact_counters(benchmark::State& state, std::size_t contacts, std::size_t points) {
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * contacts));
+  state.counters["ns_per_contact"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * contacts),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["points"] = static_cast<double>(points);
+}
+
 // End to end: a fresh cloud per iteration, the whole stream inserted.
 template <class Policy, class Index>
 void Fuse(benchmark::State& state) {
@@ -83,11 +92,7 @@ void Fuse(benchmark::State& state) {
     fused = contacts.size() - points;
     benchmark::ClobberMemory();
   }
-  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * contacts.size()));
-  state.counters["ns_per_contact"] =
-      benchmark::Counter(static_cast<double>(state.iterations() * contacts.size()),
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["points"] = static_cast<double>(points);
+  per_contact_counters(state, contacts.size(), points);
   state.counters["bytes_per_point"] = static_cast<double>(bytes) / static_cast<double>(points);
   state.counters["fused_pct"] = 100.0 * static_cast<double>(fused) / double(contacts.size());
 }
@@ -105,10 +110,7 @@ void FuseWidenedGate(benchmark::State& state) {
     points = cloud.size();
     benchmark::ClobberMemory();
   }
-  state.counters["ns_per_contact"] =
-      benchmark::Counter(static_cast<double>(state.iterations() * contacts.size()),
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["points"] = static_cast<double>(points);
+  per_contact_counters(state, contacts.size(), points);
 }
 
 // Query only: nearest_within for every contact against a finished cloud's index.
@@ -219,11 +221,7 @@ const Frames& pad_frames(ShapeId shape) {
 constexpr double kPadGate = 4e-3;
 
 void frame_counters(benchmark::State& state, const Frames& f, std::size_t points) {
-  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * f.contacts.size()));
-  state.counters["ns_per_contact"] =
-      benchmark::Counter(static_cast<double>(state.iterations() * f.contacts.size()),
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["points"] = static_cast<double>(points);
+  per_contact_counters(state, f.contacts.size(), points);
   state.counters["per_frame"] = double(f.contacts.size()) / double(f.ends.size());
 }
 
@@ -290,10 +288,7 @@ void FuseReferenceGrid(benchmark::State& state) {
     points = grid.size();
     benchmark::ClobberMemory();
   }
-  state.counters["ns_per_contact"] =
-      benchmark::Counter(static_cast<double>(state.iterations() * contacts.size()),
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["points"] = static_cast<double>(points);
+  per_contact_counters(state, contacts.size(), points);
 }
 #endif
 
