@@ -361,9 +361,9 @@ class Icp {
   Outcome iterate(const Target<S>& target, Isometry3d& t, std::size_t need, double loosen,
                   int& iterations) {
     double previous_rmse = std::numeric_limits<double>::infinity();
-    Isometry3d back = t;  // the pose the previous update started from, and its RMSE
+    // The pose the previous update started from, and its RMSE (infinite before the first).
+    Isometry3d back = t;
     double back_rmse = previous_rmse;
-    bool has_back = false;
     Outcome last{};
     hints_.assign(active_->size(), kNoHint);  // a new stage: no previous matches
     for (int it = 0; it < cfg_.max_iterations; ++it) {
@@ -396,7 +396,7 @@ class Icp {
       }
       // Back where the previous update started: the next updates would alternate between the
       // same two poses until the cap. Keep the better of the two.
-      if (has_back) {
+      if (back_rmse < std::numeric_limits<double>::infinity()) {
         const Isometry3d gap = t * back.inverse();
         if (gap.translation().norm() <= loosen * cfg_.translation_tolerance &&
             Eigen::AngleAxisd(gap.linear()).angle() <= loosen * cfg_.rotation_tolerance) {
@@ -406,7 +406,6 @@ class Icp {
       }
       back = from;
       back_rmse = rmse;
-      has_back = true;
     }
     if (last.status == Status::degenerate) return last;
     return {Status::not_converged,
