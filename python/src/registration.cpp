@@ -226,6 +226,7 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
         return "ObjectRecognition(best='" + r.best + "', margin=" + std::to_string(r.margin) + ")";
       });
 
+  const reg::LibraryConfig kLib{};
   py::class_<reg::ObjectLibrary<double>>(m, "ObjectLibrary", R"doc(
 Named object models; recognize() ranks them by how well each explains a cloud (multi-start
 point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its starts out over
@@ -250,12 +251,16 @@ point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its 
              c.threads = threads;
              return reg::ObjectLibrary<double>(c);
            }),
-           py::kw_only(), py::arg("coarse_iterations") = 10, py::arg("coarse_points") = 64,
-           py::arg("refine_points") = 512, py::arg("coarse_trim") = 0.0,
-           py::arg("pca_starts") = true, py::arg("rotation_starts") = 24,
-           py::arg("refine_best") = 2, py::arg("exact_models") = 3,
-           py::arg("hopeless_factor") = 3.0, py::arg("field_cell") = 2e-3,
-           py::arg("score_gate") = 0.01, py::arg("unknown_score") = 3e-3, py::arg("threads") = 0)
+           // The defaults are LibraryConfig's own, so the two cannot drift apart.
+           py::kw_only(), py::arg("coarse_iterations") = kLib.coarse_iterations,
+           py::arg("coarse_points") = kLib.coarse_points,
+           py::arg("refine_points") = kLib.refine_points, py::arg("coarse_trim") = kLib.coarse_trim,
+           py::arg("pca_starts") = kLib.pca_starts,
+           py::arg("rotation_starts") = kLib.rotation_starts,
+           py::arg("refine_best") = kLib.refine_best, py::arg("exact_models") = kLib.exact_models,
+           py::arg("hopeless_factor") = kLib.hopeless_factor,
+           py::arg("field_cell") = kLib.field_cell, py::arg("score_gate") = kLib.score_gate,
+           py::arg("unknown_score") = kLib.unknown_score, py::arg("threads") = kLib.threads)
       .def(
           "add",
           [](reg::ObjectLibrary<double>& lib, std::string name, const ArrayD& points,

@@ -59,7 +59,7 @@ struct LibraryConfig {
                    .rotation_tolerance = 1e-4,
                    .relative_error_tolerance = 1e-3};
   int coarse_iterations = 10;       ///< point-to-plane iterations per start on the subsample, >= 1
-  std::size_t coarse_points = 64;   ///< subsample size of the coarse stage, >= 6
+  std::size_t coarse_points = 128;  ///< subsample size of the coarse stage, >= 6
   std::size_t refine_points = 512;  ///< subsample size of the refinement, >= 6
   double coarse_trim = 0.0;         ///< trimmed fraction in the coarse stage, [0, 1)
   bool pca_starts = true;           ///< the 4 principal-axes starts
