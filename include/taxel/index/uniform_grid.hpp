@@ -115,12 +115,16 @@ class UniformGrid {
     }
     for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
     order_.resize(points_.size());
-    sorted_.resize(points_.size());
+    sx_.resize(points_.size());
+    sy_.resize(points_.size());
+    sz_.resize(points_.size());
     std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
     for (std::size_t i = 0; i < points_.size(); ++i) {  // ids ascend within each cell
       const std::uint32_t slot = fill[cell_of[i]]++;
       order_[slot] = static_cast<PointId>(i);
-      sorted_[slot] = points_[i];
+      sx_[slot] = points_[i].x();
+      sy_[slot] = points_[i].y();
+      sz_[slot] = points_[i].z();
     }
   }
 
@@ -132,8 +136,9 @@ class UniformGrid {
   [[nodiscard]] S cell() const noexcept { return cell_; }
   /// Heap bytes held.
   [[nodiscard]] std::size_t memory_bytes() const noexcept {
-    return points_.capacity() * sizeof(Vec3<S>) * 2 + start_.capacity() * sizeof(std::uint32_t) +
-           order_.capacity() * sizeof(PointId);
+    return points_.capacity() * sizeof(Vec3<S>) +
+           (sx_.capacity() + sy_.capacity() + sz_.capacity()) * sizeof(S) +
+           start_.capacity() * sizeof(std::uint32_t) + order_.capacity() * sizeof(PointId);
   }
 
   /// The closest point within distance r of q (ties by id), if any. A point whose squared
@@ -185,20 +190,25 @@ class UniformGrid {
       lo[ua] = static_cast<int>(std::clamp(l, 0.0, top));
       hi[ua] = static_cast<int>(std::clamp(h, 0.0, top));
     }
-    Neighbor<S> best{hint, h2};  // the hint is in the ball, so it is visited again
+    // The hint is in the ball, so it is visited again. Branch-free selection: which point of a
+    // row wins is data, and a branch on it mispredicts often.
+    S best_d2 = h2;
+    PointId best_id = hint;
+    const S qx = q.x(), qy = q.y(), qz = q.z();
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
         const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
         for (std::uint32_t s = start_[row + lo[0]], e = start_[row + hi[0] + 1]; s < e; ++s) {
-          const S d2 = squared_distance(sorted_[s], q);
+          const S dx = sx_[s] - qx, dy = sy_[s] - qy, dz = sz_[s] - qz;
+          const S d2 = dx * dx + dy * dy + dz * dz;  // as squared_distance computes it
           const PointId id = order_[s];
-          if (d2 < best.squared_distance || (d2 == best.squared_distance && id < best.id)) {
-            best = {id, d2};
-          }
+          const bool better = (d2 < best_d2) | ((d2 == best_d2) & (id < best_id));
+          best_d2 = better ? d2 : best_d2;
+          best_id = better ? id : best_id;
         }
       }
     }
-    return best;
+    return Neighbor<S>{best_id, best_d2};
   }
 
   /// The min(k, size()) closest points, ordered by `closer`.
@@ -364,13 +374,15 @@ class UniformGrid {
 
   template <class Visit>
   void visit_cells(std::size_t from, std::size_t to, const Vec3<S>& q, Visit& visit) const {
+    const S qx = q.x(), qy = q.y(), qz = q.z();
     for (std::uint32_t s = start_[from], e = start_[to]; s < e; ++s) {
-      visit(order_[s], squared_distance(sorted_[s], q));
+      const S dx = sx_[s] - qx, dy = sy_[s] - qy, dz = sz_[s] - qz;
+      visit(order_[s], dx * dx + dy * dy + dz * dz);  // as squared_distance computes it
     }
   }
 
   std::vector<Vec3<S>> points_;
-  std::vector<Vec3<S>> sorted_;       // points in cell order
+  std::vector<S> sx_, sy_, sz_;       // the points' coordinates in cell order
   std::vector<PointId> order_;        // id of each sorted point
   std::vector<std::uint32_t> start_;  // CSR offsets, one per cell + 1
   std::array<int, 3> dims_{1, 1, 1};

@@ -187,33 +187,37 @@ struct PointToPlane {
     // in-plane slides and spin, a sphere's rotations about its centre, a cylinder's axis), so
     // degeneracy is decided on hq and the step is taken in the directions it constrains.
     // Lower triangles only, in plain arrays (a third of the products of full outer ones).
-    std::array<double, 21> hl{}, hql{};
-    Vec6d g = Vec6d::Zero();
+    // The two systems side by side, entry k of h at [2k] and of hq at [2k + 1] (and the two
+    // Jacobians likewise), so each product pair is one two-wide vector operation.
+    alignas(16) std::array<double, 42> hh{};
+    std::array<double, 6> g6{};
     const double inv_len = 1.0 / len;
     for (const auto& c : cs) {
-      std::array<double, 6> j, jq;
       const Vec3d a = (c.p - centre).cross(c.n) * inv_len;
       const Vec3d b = (c.q - centre).cross(c.n) * inv_len;
-      j = {a.x(), a.y(), a.z(), c.n.x(), c.n.y(), c.n.z()};
-      jq = {b.x(), b.y(), b.z(), c.n.x(), c.n.y(), c.n.z()};
-      const double wr = c.weight * c.n.dot(c.p - c.q);
+      alignas(16) const std::array<double, 12> jj = {a.x(),   b.x(),   a.y(),   b.y(),
+                                                     a.z(),   b.z(),   c.n.x(), c.n.x(),
+                                                     c.n.y(), c.n.y(), c.n.z(), c.n.z()};
+      const double w = c.weight;
+      const double wr = w * c.n.dot(c.p - c.q);
       std::size_t k = 0;
       for (std::size_t u = 0; u < 6; ++u) {
-        const double wj = c.weight * j[u];
-        const double wjq = c.weight * jq[u];
-        g(static_cast<Eigen::Index>(u)) += wr * j[u];
+        const double wj0 = w * jj[2 * u], wj1 = w * jj[2 * u + 1];
+        g6[u] += wr * jj[2 * u];
         for (std::size_t v = 0; v <= u; ++v, ++k) {
-          hl[k] += wj * j[v];
-          hql[k] += wjq * jq[v];
+          hh[2 * k] += wj0 * jj[2 * v];
+          hh[2 * k + 1] += wj1 * jj[2 * v + 1];
         }
       }
     }
     Mat6d h, hq;
+    Vec6d g;
     for (std::size_t u = 0, k = 0; u < 6; ++u) {
+      g(static_cast<Eigen::Index>(u)) = g6[u];
       for (std::size_t v = 0; v <= u; ++v, ++k) {
         const auto iu = static_cast<Eigen::Index>(u), iv = static_cast<Eigen::Index>(v);
-        h(iu, iv) = h(iv, iu) = hl[k];
-        hq(iu, iv) = hq(iv, iu) = hql[k];
+        h(iu, iv) = h(iv, iu) = hh[2 * k];
+        hq(iu, iv) = hq(iv, iu) = hh[2 * k + 1];
       }
     }
     const Eigen::SelfAdjointEigenSolver<Mat6d> eig(hq);
