@@ -158,8 +158,8 @@ class UniformGrid {
     // least `margin` away, so a strictly closer answer is final.
     const S margin = visit_block(q, keep);
     if (found && best.squared_distance < margin * margin) return best;
-    found = false;
-    best = {0, r * r};
+    // The block's best (if any) bounds the answer: the shell search starts from it, so it stops
+    // as soon as no unvisited cell can hold a closer point (revisiting a point changes nothing).
     search(q, r, keep, [&] { return best.squared_distance; });
     return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
   }
