@@ -194,13 +194,11 @@ class UniformGrid {
     // row wins is data, and a branch on it mispredicts often.
     S best_d2 = h2;
     PointId best_id = hint;
-    const S qx = q.x(), qy = q.y(), qz = q.z();
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
         const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
         for (std::uint32_t s = start_[row + lo[0]], e = start_[row + hi[0] + 1]; s < e; ++s) {
-          const S dx = sx_[s] - qx, dy = sy_[s] - qy, dz = sz_[s] - qz;
-          const S d2 = dx * dx + dy * dy + dz * dz;  // as squared_distance computes it
+          const S d2 = sorted_distance(s, q);
           const PointId id = order_[s];
           const bool better = (d2 < best_d2) | ((d2 == best_d2) & (id < best_id));
           best_d2 = better ? d2 : best_d2;
@@ -374,11 +372,16 @@ class UniformGrid {
 
   template <class Visit>
   void visit_cells(std::size_t from, std::size_t to, const Vec3<S>& q, Visit& visit) const {
-    const S qx = q.x(), qy = q.y(), qz = q.z();
     for (std::uint32_t s = start_[from], e = start_[to]; s < e; ++s) {
-      const S dx = sx_[s] - qx, dy = sy_[s] - qy, dz = sz_[s] - qz;
-      visit(order_[s], dx * dx + dy * dy + dz * dz);  // as squared_distance computes it
+      visit(order_[s], sorted_distance(s, q));
     }
+  }
+
+  // Squared distance from q to the sorted point s, as squared_distance computes it (the same
+  // bits as every other index).
+  S sorted_distance(std::uint32_t s, const Vec3<S>& q) const noexcept {
+    const S dx = sx_[s] - q.x(), dy = sy_[s] - q.y(), dz = sz_[s] - q.z();
+    return dx * dx + dy * dy + dz * dz;
   }
 
   std::vector<Vec3<S>> points_;
