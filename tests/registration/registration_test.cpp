@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <taxel/index/brute_force.hpp>
 #include <taxel/index/uniform_grid.hpp>
@@ -107,6 +108,40 @@ TEST_CASE("UniformGrid answers exactly as brute force", "[registration][index]")
   CHECK_FALSE(one.nearest_within(Vec3d(std::nan(""), 0, 0), 10.0));
   CHECK_THROWS_WITH(index::UniformGrid<double>(std::vector<Vec3d>{Vec3d(0, 0, std::nan(""))}),
                     Contains("point 0 is not finite"));
+}
+
+TEMPLATE_TEST_CASE("UniformGrid is exact for queries off a sampled surface, at every range",
+                   "[registration][index]", float, double) {
+  // Points on a sphere shell, as an ICP model is: most cells are empty, and a query a cell or
+  // more off the surface finds nothing in its own 2 x 2 x 2 block (the wider ball scans and
+  // the shell search then answer it).
+  using S = TestType;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3<S>> pts;
+  for (int i = 0; i < 2000; ++i) {
+    pts.push_back((0.03 * Vec3d(g(rng), g(rng), g(rng)).normalized()).template cast<S>());
+  }
+  const index::UniformGrid<S> grid(pts);
+  const double cell = static_cast<double>(grid.cell());
+  index::BruteForce<S> brute;
+  for (std::size_t i = 0; i < pts.size(); ++i) brute.insert(static_cast<index::PointId>(i), pts[i]);
+  const S inf = std::numeric_limits<S>::infinity();
+  for (int q = 0; q < 2000; ++q) {
+    // 0 to 8 cells off the surface, inside or outside it.
+    const double off = (q % 2 == 0 ? 1.0 : -0.5) * 8.0 * cell * u(rng) * u(rng);
+    const Vec3d dir = Vec3d(g(rng), g(rng), g(rng)).normalized();
+    const Vec3<S> x = ((0.03 + off) * dir).template cast<S>();
+    const auto nearest = brute.nearest_within(x, inf);
+    REQUIRE(nearest);
+    const S exact = std::sqrt(nearest->squared_distance);
+    for (const S r : {S(0.5 * cell), S(1.5 * cell), S(2.0 * cell), S(5.0 * cell), exact, inf}) {
+      REQUIRE(grid.nearest_within(x, r) == brute.nearest_within(x, r));
+      REQUIRE(grid.nearest_within(x, r, static_cast<index::PointId>(q % pts.size())) ==
+              brute.nearest_within(x, r));
+    }
+  }
 }
 
 TEST_CASE("Target: PCA normals, exact nearest with the closest-point field, errors",

@@ -157,9 +157,25 @@ class UniformGrid {
     // Fast path: the 2 x 2 x 2 block of cells nearest to q. Every point outside it is at
     // least `margin` away, so a strictly closer answer is final.
     const S margin = visit_block(q, keep);
-    if (found && best.squared_distance < margin * margin) return best;
-    // The block's best (if any) bounds the answer: the shell search starts from it, so it stops
-    // as soon as no unvisited cell can hold a closer point (revisiting a point changes nothing).
+    if (found) {
+      if (best.squared_distance < margin * margin) return best;
+      // The block's best bounds the answer: the rows of cells meeting the ball it bounds hold
+      // every closer point (a query a cell or two off its surface, as at the start of an
+      // alignment).
+      if (scan_ball(q, best.squared_distance, best.id, kScanCells)) return best;
+    } else if (margin > S(0)) {
+      // An empty block: the cells meeting the ball of two cells (or r, if smaller) around q.
+      // A point found there is the answer; none means none within r when r is that small.
+      const S reach = std::min(r, S(2) * cell_);
+      S d2 = std::min(reach * reach, std::numeric_limits<S>::max());
+      PointId id = kNone;
+      if (scan_ball(q, d2, id, kScanCells)) {
+        if (id != kNone) return Neighbor<S>{id, d2};
+        if (r <= S(2) * cell_) return std::nullopt;
+      }
+    }
+    // Wider: shells of cells outward from q, from the best so far (revisiting a point changes
+    // nothing), until no unvisited cell can hold a closer point.
     search(q, r, keep, [&] { return best.squared_distance; });
     return found ? std::optional<Neighbor<S>>(best) : std::nullopt;
   }
@@ -176,36 +192,11 @@ class UniformGrid {
     }
     const S h2 = squared_distance(points_[hint], q);
     if (!(h2 <= r * r)) return nearest_within(q, r);
-    // The cells a point within sqrt(h2) of q can fall in, padded against the rounding of
-    // cell coordinates; a ball over more than three cells per axis goes the general way.
-    const double reach = std::sqrt(static_cast<double>(h2)) / static_cast<double>(cell_) + 1e-3;
-    std::array<int, 3> lo{}, hi{};
-    const Vec3<S> c = coord(q);
-    for (int a = 0; a < 3; ++a) {
-      const auto ua = static_cast<std::size_t>(a);
-      const double x = static_cast<double>(c[a]);
-      const double top = dims_[ua] - 1;
-      const double l = std::floor(x - reach), h = std::floor(x + reach);
-      if (!(h - l <= 2.0)) return nearest_within(q, r);
-      lo[ua] = static_cast<int>(std::clamp(l, 0.0, top));
-      hi[ua] = static_cast<int>(std::clamp(h, 0.0, top));
-    }
-    // The hint is in the ball, so it is visited again. Branch-free selection: which point of a
-    // row wins is data, and a branch on it mispredicts often.
     S best_d2 = h2;
     PointId best_id = hint;
-    for (int z = lo[2]; z <= hi[2]; ++z) {
-      for (int y = lo[1]; y <= hi[1]; ++y) {
-        const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
-        for (std::uint32_t s = start_[row + lo[0]], e = start_[row + hi[0] + 1]; s < e; ++s) {
-          const S d2 = sorted_distance(s, q);
-          const PointId id = order_[s];
-          const bool better = (d2 < best_d2) | ((d2 == best_d2) & (id < best_id));
-          best_d2 = better ? d2 : best_d2;
-          best_id = better ? id : best_id;
-        }
-      }
-    }
+    // A ball over more than three cells per axis goes the general way: a hint that far says
+    // little about where the answer lies, and the 2 x 2 x 2 block often settles it.
+    if (!scan_ball(q, best_d2, best_id, 3)) return nearest_within(q, r);
     return Neighbor<S>{best_id, best_d2};
   }
 
@@ -244,6 +235,51 @@ class UniformGrid {
   }
 
  private:
+  // The closest point to q among those within sqrt(best_d2) of it, ties by id, starting from
+  // (best_d2, best_id): a point at that distance, or kNone for a bare radius. Reads the rows
+  // of the cells meeting that ball (padded against the rounding of cell coordinates).
+  // False, with nothing changed, when the ball spans more than max_cells cells on an axis.
+  bool scan_ball(const Vec3<S>& q, S& best_d2, PointId& best_id, int max_cells) const {
+    const double reach =
+        std::sqrt(static_cast<double>(best_d2)) / static_cast<double>(cell_) + 1e-3;
+    std::array<int, 3> lo{}, hi{};
+    const Vec3<S> c = coord(q);
+    for (int a = 0; a < 3; ++a) {
+      const auto ua = static_cast<std::size_t>(a);
+      const double x = static_cast<double>(c[a]);
+      const double top = dims_[ua] - 1;
+      const double l = std::floor(x - reach), h = std::floor(x + reach);
+      if (!(h - l < double(max_cells))) return false;
+      lo[ua] = static_cast<int>(std::clamp(l, 0.0, top));
+      hi[ua] = static_cast<int>(std::clamp(h, 0.0, top));
+    }
+    scan_rows(q, lo, hi, best_d2, best_id);
+    return true;
+  }
+
+  // The closest point to q in the box of cells [lo, hi] (inclusive, inside the grid) that beats
+  // (best_d2, best_id), ties by id, selected without branches: which point of a row wins is
+  // data, and a branch on it mispredicts often.
+  void scan_rows(const Vec3<S>& q, const std::array<int, 3>& lo, const std::array<int, 3>& hi,
+                 S& best_d2, PointId& best_id) const {
+    S d2_best = best_d2;
+    PointId id_best = best_id;
+    for (int z = lo[2]; z <= hi[2]; ++z) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
+        for (std::uint32_t s = start_[row + lo[0]], e = start_[row + hi[0] + 1]; s < e; ++s) {
+          const S d2 = sorted_distance(s, q);
+          const PointId id = order_[s];
+          const bool better = (d2 < d2_best) | ((d2 == d2_best) & (id < id_best));
+          d2_best = better ? d2 : d2_best;
+          id_best = better ? id : id_best;
+        }
+      }
+    }
+    best_d2 = d2_best;
+    best_id = id_best;
+  }
+
   // The mean nearest-neighbour distance of up to 64 evenly spread points (brute force).
   [[nodiscard]] double mean_spacing() const {
     const std::size_t n = points_.size();
@@ -392,6 +428,8 @@ class UniformGrid {
   Vec3<S> lo_ = Vec3<S>::Zero();
   S cell_ = S(1);
   S inv_cell_ = S(1);
+  static constexpr int kScanCells = 7;  // widest ball read without a hint, cells per axis
+  static constexpr PointId kNone = std::numeric_limits<PointId>::max();  // no point yet
 };
 
 }  // namespace taxel::index
