@@ -203,6 +203,67 @@ TEST_CASE("readings to contacts: the censoring correction removes the threshold'
   CHECK(tsn::truncation_bias(0.0, 0.0, 0.3e-3) == Approx(0.3e-3 * std::sqrt(2 / M_PI)));
 }
 
+TEST_CASE("readings to contacts: normals at the rim of a noisy contact are not flattened",
+          "[sensor]") {
+  // The paraboloid cap of the censoring test (curvature radius 40 mm), read with the default
+  // noise. The true slope of the depth at tactel (x, y) is -(x - x0, y - y0) / R. At the rim of
+  // the contact (a tactel with an inactive neighbour) a 3x3 plane's slope belongs to the
+  // centroid of the active neighbours, inward, so it is too small; the pad-wide quadric's
+  // gradient at the tactel is not. Gain: the least-squares factor from true to estimated slope.
+  tsn::SensorModel m;
+  m.sigma_position = m.sigma_tilt = 0.0;
+  tsn::ContactExtractor quadric(m), plane(m, {.refine_censoring = false});
+  const double R = 0.04;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> press(0.7e-3, 1.5e-3), shift(-1.7e-3, 1.7e-3);
+  double sq = 0, sq_plane = 0, ss = 0;  // sums of true x estimated slope, and of true^2
+  std::size_t n_rim = 0;
+  for (int frame = 0; frame < 2000; ++frame) {
+    const double depth = press(rng), x0 = shift(rng), y0 = shift(rng);
+    tsn::PadMatrix counts = tsn::PadMatrix::Zero(14, 6);
+    for (int i = 0; i < 84; ++i) {
+      const taxel::Vec3d at = m.geometry.tactel(i / 6, i % 6);
+      const double d =
+          depth - ((at.x() - x0) * (at.x() - x0) + (at.y() - y0) * (at.y() - y0)) / (2 * R);
+      if (d <= 0) continue;
+      const double k = std::round((d + m.sigma_normal * gauss(rng)) / m.depth_per_count());
+      counts(i / 6, i % 6) = static_cast<std::uint16_t>(k >= m.threshold ? std::min(k, 4095.0) : 0);
+    }
+    const auto on = [&](int r, int c) {
+      return r >= 0 && r < 14 && c >= 0 && c < 6 && counts(r, c) >= m.threshold &&
+             counts(r, c) < 4095;
+    };
+    std::vector<taxel::Contact<double>> a, b;
+    quadric.extract(counts, Eigen::Isometry3d::Identity(), 0.0, a);
+    plane.extract(counts, Eigen::Isometry3d::Identity(), 0.0, b);
+    REQUIRE(a.size() == b.size());
+    std::size_t k = 0;
+    for (int i = 0; i < 84; ++i) {
+      const int r = i / 6, c = i % 6;
+      if (!on(r, c)) continue;
+      int neighbours = 0;
+      for (int dr = -1; dr <= 1; ++dr)
+        for (int dc = -1; dc <= 1; ++dc) neighbours += (dr != 0 || dc != 0) && on(r + dr, c + dc);
+      const taxel::Vec3d at = m.geometry.tactel(r, c);
+      const double tx = -(at.x() - x0) / R, ty = -(at.y() - y0) / R;
+      // The normal is -(g_x, g_y, 1) / |.|, so g = (n_x, n_y) / n_z.
+      const taxel::Vec3d na = *a[k].normal, nb = *b[k].normal;
+      if (neighbours >= 3 && neighbours < 8 && r > 0 && r < 13 && c > 0 && c < 5) {
+        sq += tx * na.x() / na.z() + ty * na.y() / na.z();
+        sq_plane += tx * nb.x() / nb.z() + ty * nb.y() / nb.z();
+        ss += tx * tx + ty * ty;
+        ++n_rim;
+      }
+      ++k;
+    }
+  }
+  REQUIRE(n_rim > 10000);
+  CHECK(sq / ss > 0.9);  // about 0.99
+  CHECK(sq / ss < 1.05);
+  CHECK(sq_plane / ss < 0.85);  // about 0.76: the plane's fallback flattens the rim
+}
+
 TEST_CASE("readings to contacts: per pad, the quadric's point above the centroid", "[sensor]") {
   const tsn::SensorModel m = noiseless();
   tsn::ContactExtractor ex(m, {.mode = tsn::ContactMode::per_pad});
