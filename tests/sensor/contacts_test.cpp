@@ -264,6 +264,55 @@ TEST_CASE("readings to contacts: normals at the rim of a noisy contact are not f
   CHECK(sq_plane / ss < 0.85);  // about 0.76: the plane's fallback flattens the rim
 }
 
+TEST_CASE("readings to contacts: the quadric's slope variance against the scatter of its normals",
+          "[sensor]") {
+  // One cap (curvature radius 40 mm, pressed 1.5 mm) read again and again with fresh depth
+  // noise. For a deep tactel the stated variance along the normal is the depth's (the
+  // correction is nil there) plus pitch^2 / 12 times the two slope variances, so those can be
+  // read back and set against the scatter of the slopes g = (n_x, n_y) / n_z. The stated
+  // slope variance is the least-squares one, depth noise times e' A^-1 e; it leaves out how
+  // the censoring correction amplifies the noise of the rim tactels through the fit (their
+  // corrected depth rises with the fitted one), so the slopes scatter about 1.3 times as much.
+  // That share of the variance along the normal is about 0.4 % (at most a few per cent).
+  tsn::SensorModel m;
+  m.sigma_position = m.sigma_tilt = 0.0;
+  tsn::ContactExtractor ex(m);
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double vd =
+      m.sigma_normal * m.sigma_normal + m.depth_per_count() * m.depth_per_count() / 12.0;
+  const double q2 = m.geometry.pitch * m.geometry.pitch / 12.0;
+  for (const int probe : {6 * 6 + 2, 6 * 7 + 3}) {  // the two tactels nearest the cap's top
+    double sx = 0, sxx = 0, sy = 0, syy = 0, stated = 0;
+    const int runs = 4000;
+    for (int run = 0; run < runs; ++run) {
+      tsn::PadMatrix counts = tsn::PadMatrix::Zero(14, 6);
+      for (int i = 0; i < 84; ++i) {
+        const taxel::Vec3d at = m.geometry.tactel(i / 6, i % 6);
+        const double d = 1.5e-3 - (at.x() * at.x() + at.y() * at.y()) / 0.08;
+        if (d <= 0) continue;
+        const double k = std::round((d + m.sigma_normal * gauss(rng)) / m.depth_per_count());
+        counts(i / 6, i % 6) =
+            static_cast<std::uint16_t>(k >= m.threshold ? std::min(k, 4095.0) : 0);
+      }
+      REQUIRE(counts(probe / 6, probe % 6) >= m.threshold);
+      std::vector<taxel::Contact<double>> out;
+      ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out);
+      std::size_t k = 0;
+      for (int i = 0; i < probe; ++i) k += counts(i / 6, i % 6) >= m.threshold;
+      const taxel::Vec3d n = *out[k].normal;
+      const double gx = n.x() / n.z(), gy = n.y() / n.z();
+      sx += gx, sxx += gx * gx, sy += gy, syy += gy * gy;
+      const double along = n.dot(out[k].covariance * n);
+      stated += (along - vd) / q2;
+      CHECK(along - vd < 0.05 * along);
+    }
+    const double scatter = (sxx - sx * sx / runs + syy - sy * sy / runs) / (runs - 1);
+    CHECK(scatter / (stated / runs) > 1.0);  // about 1.27
+    CHECK(scatter / (stated / runs) < 1.45);
+  }
+}
+
 TEST_CASE("readings to contacts: per pad, the quadric's point above the centroid", "[sensor]") {
   const tsn::SensorModel m = noiseless();
   tsn::ContactExtractor ex(m, {.mode = tsn::ContactMode::per_pad});
