@@ -162,6 +162,7 @@ void BM_PointToPlane_2k_vs_10k_iterations(benchmark::State& state) {
   cfg.max_distance = 0.01;
   cfg.translation_tolerance = 0.0;
   cfg.rotation_tolerance = 0.0;
+  cfg.keep_stable_matches = state.range(1) != 0;
   Icp<PointToPlane> icp(cfg);
   std::size_t k = 0;
   double error = 0.0, runs = 0.0;
@@ -175,7 +176,10 @@ void BM_PointToPlane_2k_vs_10k_iterations(benchmark::State& state) {
   state.counters["pose_err_mm"] = 1e3 * error / runs;
 }
 BENCHMARK(BM_PointToPlane_2k_vs_10k)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_PointToPlane_2k_vs_10k_iterations)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointToPlane_2k_vs_10k_iterations)
+    ->ArgNames({"iterations", "keep_stable"})
+    ->ArgsProduct({{1, 10}, {1, 0}})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPlane_2k_vs_10k_field)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPlane_2k_vs_10k_coarse)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointToPoint_2k_vs_10k)->Unit(benchmark::kMillisecond);

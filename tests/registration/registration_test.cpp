@@ -193,6 +193,111 @@ TEST_CASE("Target: PCA normals, exact nearest with the closest-point field, erro
                     Contains("normal_neighbors = 2"));
 }
 
+TEMPLATE_TEST_CASE("UniformGrid's stable radius: every query within it has the same nearest point",
+                   "[registration][index]", float, double) {
+  // Points on a sphere shell, and some exact duplicates (a tie: no radius). Oracles: the
+  // radius never exceeds half the gap between the nearest and the second-nearest point (brute
+  // force), and queries drawn inside the ball keep the answer.
+  using S = TestType;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3<S>> pts;
+  for (int i = 0; i < 3000; ++i) {
+    pts.push_back((0.03 * Vec3d(g(rng), g(rng), g(rng)).normalized()).template cast<S>());
+  }
+  for (int i = 0; i < 100; ++i) pts.push_back(pts[static_cast<std::size_t>(7 * i)]);
+  const index::UniformGrid<S> grid(pts);
+  const double cell = static_cast<double>(grid.cell());
+  index::BruteForce<S> brute;
+  for (std::size_t i = 0; i < pts.size(); ++i) brute.insert(static_cast<index::PointId>(i), pts[i]);
+  const S inf = std::numeric_limits<S>::infinity();
+  int positive = 0, tied = 0, tied_zero = 0;
+  for (int q = 0; q < 3000; ++q) {
+    const double off = (q % 2 == 0 ? 1.0 : -0.5) * 2.0 * cell * u(rng) * u(rng);
+    const Vec3d dir = Vec3d(g(rng), g(rng), g(rng)).normalized();
+    const Vec3<S> x = ((0.03 + off) * dir).template cast<S>();
+    const std::vector<index::Neighbor<S>> two = brute.knn(x, 2);
+    REQUIRE(two.size() == 2);
+    // Hints: the answer, a near point (the second), an arbitrary id, one out of range.
+    for (const index::PointId hint : {two[0].id, two[1].id, static_cast<index::PointId>(q),
+                                      static_cast<index::PointId>(pts.size())}) {
+      for (const S r : {S(0.5 * cell), inf}) {
+        const auto st = grid.nearest_stable(x, r, hint);
+        const auto nb = brute.nearest_within(x, r);
+        REQUIRE(st.has_value() == nb.has_value());
+        if (!st) continue;
+        REQUIRE(st->nearest == *nb);
+        const double d1 = std::sqrt(static_cast<double>(two[0].squared_distance));
+        const double d2 = std::sqrt(static_cast<double>(two[1].squared_distance));
+        REQUIRE(st->radius >= 0.0);
+        REQUIRE(st->radius <= 0.5 * (d2 - d1));
+        if (two[0].squared_distance == two[1].squared_distance) {
+          ++tied;
+          tied_zero += st->radius == 0.0;
+        }
+        if (st->radius == 0.0) continue;
+        ++positive;
+        for (int k = 0; k < 8; ++k) {
+          const Vec3d step = Vec3d(g(rng), g(rng), g(rng)).normalized() *
+                             (k == 0 ? 0.999 : std::cbrt(u(rng))) * st->radius;
+          const Vec3<S> y = (x.template cast<double>() + step).template cast<S>();
+          REQUIRE(brute.nearest_within(y, inf)->id == st->nearest.id);
+        }
+      }
+    }
+  }
+  INFO("positive radii " << positive << ", ties " << tied);
+  CHECK(positive > 5000);  // not vacuous: most hinted answers near the surface have a radius
+  CHECK(tied > 0);
+  CHECK(tied_zero == tied);
+}
+
+TEMPLATE_TEST_CASE("ICP keeping stable matches gives the same result as searching every time",
+                   "[registration][icp]", float, double) {
+  using S = TestType;
+  const PointCloud<double> model = asymmetric(8000, 5);
+  PointCloud<S> cast;
+  for (const Vec3d& p : model.points) cast.points.push_back(p.template cast<S>());
+  for (const Vec3d& n : model.normals) cast.normals.push_back(n.template cast<S>());
+  const Target<S> tg(cast);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g(0.0, 1.0);
+  int compared = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    std::vector<Vec3d> own;
+    for (std::size_t i = static_cast<std::size_t>(trial); i < model.size(); i += 5) {
+      own.push_back(model.points[i] + 2e-4 * Vec3d(g(rng), g(rng), g(rng)));
+    }
+    const Isometry3d truth = pose(0.05 + 0.03 * trial, Vec3d(g(rng), g(rng), g(rng)),
+                                  0.003 * Vec3d(g(rng), g(rng), g(rng)));
+    std::vector<Vec3<S>> source;
+    for (const Vec3d& p : moved(truth.inverse(), own)) source.push_back(p.template cast<S>());
+    IcpConfig cfg;
+    cfg.max_iterations = 30;
+    cfg.translation_tolerance = 0.0;
+    cfg.rotation_tolerance = 0.0;
+    cfg.max_distance = trial % 2 == 0 ? 0.004 : std::numeric_limits<double>::infinity();
+    cfg.trim_fraction = trial % 3 == 0 ? 0.1 : 0.0;
+    IcpConfig searching = cfg;
+    searching.keep_stable_matches = false;
+    const auto same = [&](const IcpResult& a, const IcpResult& b) {
+      CHECK(a.status == b.status);
+      CHECK(a.iterations == b.iterations);
+      CHECK(a.transform.matrix() == b.transform.matrix());
+      CHECK(a.rmse == b.rmse);
+      CHECK(a.inliers == b.inliers);
+      CHECK(a.information == b.information);
+      ++compared;
+    };
+    same(Icp<PointToPlane>(cfg).align(tg, std::span<const Vec3<S>>(source)),
+         Icp<PointToPlane>(searching).align(tg, std::span<const Vec3<S>>(source)));
+    same(Icp<PointToPoint>(cfg).align(tg, std::span<const Vec3<S>>(source)),
+         Icp<PointToPoint>(searching).align(tg, std::span<const Vec3<S>>(source)));
+  }
+  CHECK(compared == 12);
+}
+
 TEST_CASE(
     "ICP recovers known transforms exactly without noise, point-to-plane needs fewer "
     "iterations",

@@ -200,6 +200,48 @@ class UniformGrid {
     return Neighbor<S>{best_id, best_d2};
   }
 
+  /// The answer of nearest_within(q, r, hint), and how far q may move and keep it.
+  struct Stable {
+    Neighbor<S> nearest;
+    /// Every query within this distance of q [m] has the same nearest point (not strictly
+    /// tied with another), allowing for the rounding of the distances: with d the answer's
+    /// distance and c a lower bound on every other point's, a query moved by less than
+    /// (c - d) / 2 stays closer to the answer than to any other point (triangle inequality).
+    /// 0 when no such bound was worked out.
+    double radius = 0.0;
+  };
+
+  /// nearest_within(q, r, hint), and the radius of the ball around q whose queries share its
+  /// answer. The other points' lower bound c is the nearer of the second-closest point read
+  /// and the faces of the box of cells read, so this costs one more comparison per point.
+  /// ICP keeps a source point's match while the point moves less than that radius, without
+  /// searching: the same correspondences as a search.
+  [[nodiscard]] std::optional<Stable> nearest_stable(const Vec3<S>& q, S r, PointId hint) const {
+    if (!points_.empty() && q.allFinite() && r >= S(0) && hint < points_.size()) {
+      const S h2 = squared_distance(points_[hint], q);
+      if (h2 <= r * r) {
+        S best_d2 = h2, second_d2 = std::numeric_limits<S>::infinity();
+        PointId best_id = hint;
+        double face = 0.0;
+        if (scan_ball(q, best_d2, best_id, 3, &second_d2, &face)) {
+          // Rounding: the cell coordinates and every distance are within a few ulps of S of
+          // the coordinates' magnitudes (query, grid origin, distances).
+          const double best = std::sqrt(static_cast<double>(best_d2));
+          const double clear = std::min(std::sqrt(static_cast<double>(second_d2)), face);
+          const double scale = q.template cast<double>().cwiseAbs().sum() +
+                               lo_.template cast<double>().cwiseAbs().sum() +
+                               static_cast<double>(cell_) + clear;
+          const double allowance =
+              16.0 * static_cast<double>(std::numeric_limits<S>::epsilon()) * scale;
+          const double radius = 0.5 * (clear - best) - allowance;
+          return Stable{{best_id, best_d2}, std::isfinite(radius) ? std::max(radius, 0.0) : 0.0};
+        }
+      }
+    }
+    const auto nb = nearest_within(q, r, hint);
+    return nb ? std::optional<Stable>(Stable{*nb, 0.0}) : std::nullopt;
+  }
+
   /// The min(k, size()) closest points, ordered by `closer`.
   [[nodiscard]] std::vector<Neighbor<S>> knn(const Vec3<S>& q, std::size_t k) const {
     k = std::min(k, size());
@@ -239,7 +281,11 @@ class UniformGrid {
   // (best_d2, best_id): a point at that distance, or kNone for a bare radius. Reads the rows
   // of the cells meeting that ball (padded against the rounding of cell coordinates).
   // False, with nothing changed, when the ball spans more than max_cells cells on an axis.
-  bool scan_ball(const Vec3<S>& q, S& best_d2, PointId& best_id, int max_cells) const {
+  // With `second`, also the smallest squared distance of the other points read, and in `face`
+  // the distance [m] from q to the nearest face of the box of cells read that borders cells
+  // of the grid (infinite when the box is the whole grid).
+  bool scan_ball(const Vec3<S>& q, S& best_d2, PointId& best_id, int max_cells, S* second = nullptr,
+                 double* face = nullptr) const {
     const double reach =
         std::sqrt(static_cast<double>(best_d2)) / static_cast<double>(cell_) + 1e-3;
     std::array<int, 3> lo{}, hi{};
@@ -253,17 +299,34 @@ class UniformGrid {
       lo[ua] = static_cast<int>(std::clamp(l, 0.0, top));
       hi[ua] = static_cast<int>(std::clamp(h, 0.0, top));
     }
-    scan_rows(q, lo, hi, best_d2, best_id);
+    if (second == nullptr) {
+      scan_rows<false>(q, lo, hi, best_d2, best_id, nullptr);
+      return true;
+    }
+    scan_rows<true>(q, lo, hi, best_d2, best_id, second);
+    // Every cell outside the box lies beyond one of its faces, along that face's axis (q
+    // itself lies inside the box along any axis whose face borders grid cells).
+    double f = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      const auto ua = static_cast<std::size_t>(a);
+      const double x = static_cast<double>(c[a]);
+      if (lo[ua] > 0) f = std::min(f, x - lo[ua]);
+      if (hi[ua] < dims_[ua] - 1) f = std::min(f, hi[ua] + 1 - x);
+    }
+    *face = std::max(f, 0.0) * static_cast<double>(cell_);
     return true;
   }
 
   // The closest point to q in the box of cells [lo, hi] (inclusive, inside the grid) that beats
   // (best_d2, best_id), ties by id, selected without branches: which point of a row wins is
-  // data, and a branch on it mispredicts often.
+  // data, and a branch on it mispredicts often. With kSecond, also the smallest squared
+  // distance of the points read other than the winner (into *second, which starts it).
+  template <bool kSecond>
   void scan_rows(const Vec3<S>& q, const std::array<int, 3>& lo, const std::array<int, 3>& hi,
-                 S& best_d2, PointId& best_id) const {
+                 S& best_d2, PointId& best_id, S* second) const {
     S d2_best = best_d2;
     PointId id_best = best_id;
+    S d2_second = kSecond ? *second : S(0);
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
         const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
@@ -271,6 +334,12 @@ class UniformGrid {
           const S d2 = sorted_distance(s, q);
           const PointId id = order_[s];
           const bool better = (d2 < d2_best) | ((d2 == d2_best) & (id < id_best));
+          if constexpr (kSecond) {
+            // A displaced winner is a real point (the hint or one read); the winner itself,
+            // read again, is not another point.
+            const S other = id == id_best ? d2_second : std::min(d2_second, d2);
+            d2_second = better ? d2_best : other;
+          }
           d2_best = better ? d2 : d2_best;
           id_best = better ? id : id_best;
         }
@@ -278,6 +347,7 @@ class UniformGrid {
     }
     best_d2 = d2_best;
     best_id = id_best;
+    if constexpr (kSecond) *second = d2_second;
   }
 
   // The mean nearest-neighbour distance of up to 64 evenly spread points (brute force).

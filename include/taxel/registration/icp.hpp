@@ -54,6 +54,11 @@ struct IcpConfig {
   /// tolerances ten times looser), then the whole source, exactly, from there. Iterations
   /// count both stages. 0: off.
   std::size_t coarse_points = 0;
+  /// Keep a source point's exact match without searching while the point has moved, since the
+  /// search that found it, less than half the gap between that match's distance and every
+  /// other target point's (index::UniformGrid::nearest_stable): the same correspondences,
+  /// found by fewer searches once the updates become small. Off only to time the searches.
+  bool keep_stable_matches = true;
 };
 
 /// The outcome of one alignment. `ok`: converged (the update fell below the tolerances, the
@@ -370,6 +375,7 @@ class Icp {
     double back_rmse = previous_rmse;
     Outcome last{};
     hints_.assign(active_->size(), kNoHint);  // a new stage: no previous matches
+    stable_.assign(active_->size(), Anchor{});
     for (int it = 0; it < cfg_.max_iterations; ++it) {
       const double rmse = correspond(target, t);
       if (pairs_.size() < need) {
@@ -431,13 +437,30 @@ class Icp {
       index::PointId id = 0;
       if (const auto approx = approximate_ ? target.field_nearest(ps) : std::nullopt) {
         id = *approx;
+      } else if (hints_[i] != kNoHint && (p - stable_[i].at).squaredNorm() < stable_[i].radius2) {
+        // Moved less than the stable radius of its last search: that match is still the
+        // nearest, within the gate exactly when the search would find it there.
+        id = hints_[i];
+        if (!(index::squared_distance(pts[id], ps) <= gate * gate)) {
+          hints_[i] = kNoHint;
+          stable_[i] = Anchor{};
+          continue;
+        }
       } else {
         // Exact, searched from the point's previous match: after a small update the match
         // moves little, so the ball it bounds holds few cells (the same answer as without).
-        const auto nb = hints_[i] == kNoHint ? target.nearest_within(ps, gate)
-                                             : target.nearest_within(ps, gate, hints_[i]);
+        std::optional<index::Neighbor<S>> nb;
+        if (hints_[i] == kNoHint) {
+          nb = target.nearest_within(ps, gate);
+        } else if (!cfg_.keep_stable_matches) {
+          nb = target.nearest_within(ps, gate, hints_[i]);
+        } else if (const auto st = target.nearest_stable(ps, gate, hints_[i])) {
+          nb = st->nearest;
+          stable_[i] = Anchor{p, st->radius * st->radius};
+        }
         if (!nb) {
           hints_[i] = kNoHint;
+          stable_[i] = Anchor{};
           continue;
         }
         id = nb->id;
@@ -499,6 +522,13 @@ class Icp {
   std::vector<Correspondence> pairs_;
   std::vector<double> scratch_;
   std::vector<index::PointId> hints_;  // each active point's last exact match, or kNoHint
+  // Where each active point was when its match was last searched, and the squared radius
+  // around there within which that match stays its nearest (0: search again).
+  struct Anchor {
+    Vec3d at = Vec3d::Zero();
+    double radius2 = 0.0;
+  };
+  std::vector<Anchor> stable_;
 };
 
 }  // namespace taxel::registration

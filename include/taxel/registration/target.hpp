@@ -142,6 +142,21 @@ class Target {
     return nearest_within(q, r);
   }
 
+  /// nearest_within(q, r, hint), with the radius of the ball of queries around q that share
+  /// its answer (index::UniformGrid::nearest_stable); the radius is 0 where the search does
+  /// not take the grid's hinted path.
+  [[nodiscard]] std::optional<typename index::UniformGrid<S>::Stable> nearest_stable(
+      const Vec3<S>& q, S r, index::PointId hint) const {
+    if (hint < size() && q.allFinite() && r >= S(0)) {
+      const S near = S(3) * grid_.cell();
+      const S h2 = index::squared_distance(grid_.points()[hint], q);
+      if (h2 <= r * r && h2 <= near * near) return grid_.nearest_stable(q, std::min(r, near), hint);
+    }
+    const auto nb = nearest_within(q, r);
+    using Stable = typename index::UniformGrid<S>::Stable;
+    return nb ? std::optional<Stable>(Stable{*nb, 0.0}) : std::nullopt;
+  }
+
   /// The id of the point nearest to the centre of q's closest-point-field cell, or nothing
   /// outside the field (or without one). One memory load; errs by up to half a cell diagonal.
   [[nodiscard]] std::optional<index::PointId> field_nearest(const Vec3<S>& q) const {
