@@ -58,6 +58,22 @@ void check_against_brute(const taxel::registration::Target<double>& t,
     const auto b = brute.nearest_within(q, r);
     if (a.has_value() != b.has_value()) std::abort();
     if (a && a->squared_distance != b->squared_distance) std::abort();
+    // From a hint, with the radius of the ball whose queries share the answer: never more
+    // than half the gap between the nearest and the second-nearest point.
+    const auto two = brute.knn(q, 2);
+    for (const auto hint :
+         {taxel::index::PointId{0}, static_cast<taxel::index::PointId>(pts.size() - 1),
+          two.empty() ? taxel::index::PointId{0} : two.front().id}) {
+      const auto st = t.nearest_stable(q, r, hint);
+      if (st.has_value() != b.has_value()) std::abort();
+      if (!st) continue;
+      if (st->nearest.squared_distance != b->squared_distance) std::abort();
+      if (!(st->radius >= 0.0)) std::abort();
+      if (two.size() == 2 && st->radius > 0.5 * (std::sqrt(two[1].squared_distance) -
+                                                 std::sqrt(two[0].squared_distance))) {
+        std::abort();
+      }
+    }
   }
 }
 
@@ -92,6 +108,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         tr::Icp<tr::PointToPoint>({.max_iterations = 10}).align(target, source, start);
     for (const auto* r : {&a, &b}) {
       if (!r->transform.matrix().allFinite() || !std::isfinite(r->rmse)) std::abort();
+    }
+    // Keeping stable matches changes no correspondence, so no bit of the result.
+    const tr::IcpResult c =
+        tr::Icp<tr::PointToPlane>({.max_iterations = 10, .keep_stable_matches = false})
+            .align(target, source, start);
+    if (!(c.transform.matrix() == a.transform.matrix()) || !(c.rmse == a.rmse) ||
+        c.iterations != a.iterations) {
+      std::abort();
     }
 
     tr::LibraryConfig lc;
