@@ -54,6 +54,18 @@ std::vector<Vec3d> moved(const Isometry3d& T, const std::vector<Vec3d>& pts) {
   return out;
 }
 
+// n points drawn uniformly on a sphere shell of radius 30 mm (an ICP model: most grid cells
+// empty), from the caller's generator and distribution.
+template <class S>
+std::vector<Vec3<S>> sphere_shell(int n, std::mt19937_64& rng,
+                                  std::normal_distribution<double>& g) {
+  std::vector<Vec3<S>> pts;
+  for (int i = 0; i < n; ++i) {
+    pts.push_back((0.03 * Vec3d(g(rng), g(rng), g(rng)).normalized()).template cast<S>());
+  }
+  return pts;
+}
+
 IcpConfig tight() {
   IcpConfig cfg;
   cfg.max_iterations = 300;
@@ -119,10 +131,7 @@ TEMPLATE_TEST_CASE("UniformGrid is exact for queries off a sampled surface, at e
   std::mt19937_64 rng(7);
   std::normal_distribution<double> g(0.0, 1.0);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<Vec3<S>> pts;
-  for (int i = 0; i < 2000; ++i) {
-    pts.push_back((0.03 * Vec3d(g(rng), g(rng), g(rng)).normalized()).template cast<S>());
-  }
+  const std::vector<Vec3<S>> pts = sphere_shell<S>(2000, rng, g);
   const index::UniformGrid<S> grid(pts);
   const double cell = static_cast<double>(grid.cell());
   index::BruteForce<S> brute;
@@ -203,10 +212,7 @@ TEMPLATE_TEST_CASE("UniformGrid's stable radius: every query within it has the s
   std::mt19937_64 rng(11);
   std::normal_distribution<double> g(0.0, 1.0);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<Vec3<S>> pts;
-  for (int i = 0; i < 3000; ++i) {
-    pts.push_back((0.03 * Vec3d(g(rng), g(rng), g(rng)).normalized()).template cast<S>());
-  }
+  std::vector<Vec3<S>> pts = sphere_shell<S>(3000, rng, g);
   for (int i = 0; i < 100; ++i) pts.push_back(pts[static_cast<std::size_t>(7 * i)]);
   const index::UniformGrid<S> grid(pts);
   const double cell = static_cast<double>(grid.cell());

@@ -40,6 +40,28 @@ tsn::PadMatrix readings(const tsn::SensorModel& m, Depth depth) {
   return out;
 }
 
+// Noisy readings of a cap of curvature radius 40 mm pressed `depth` [m] into the pad with its
+// top at (x0, y0) [m]: each touched tactel reads its depth plus Gaussian noise, rounded, and
+// reads 0 below the threshold. `truth` gets the cap's depth at each tactel (row-major).
+template <class Rng>
+tsn::PadMatrix noisy_cap(const tsn::SensorModel& m, double depth, double x0, double y0, Rng& rng,
+                         std::normal_distribution<double>& gauss, std::vector<double>& truth) {
+  const int tactels = m.geometry.rows * m.geometry.cols;
+  tsn::PadMatrix counts = tsn::PadMatrix::Zero(m.geometry.rows, m.geometry.cols);
+  truth.assign(static_cast<std::size_t>(tactels), 0.0);
+  for (int i = 0; i < tactels; ++i) {
+    const int r = i / m.geometry.cols, c = i % m.geometry.cols;
+    const Vec3d at = m.geometry.tactel(r, c);
+    const double d = depth - ((at.x() - x0) * (at.x() - x0) + (at.y() - y0) * (at.y() - y0)) / 0.08;
+    truth[static_cast<std::size_t>(i)] = d;
+    if (d <= 0) continue;  // not touched: no reading
+    const double k = std::round((d + m.sigma_normal * gauss(rng)) / m.depth_per_count());
+    counts(r, c) =
+        static_cast<std::uint16_t>(k >= m.threshold ? std::min(k, double(m.levels - 1)) : 0.0);
+  }
+  return counts;
+}
+
 }  // namespace
 
 TEST_CASE("readings to contacts: normals of a tilted plane are exact", "[sensor]") {
@@ -153,17 +175,10 @@ TEST_CASE("readings to contacts: the censoring correction removes the threshold'
   const double t = (m.threshold - 0.5) * m.depth_per_count();
   double err = 0, err_plain = 0, rim = 0, rim_plain = 0, rim_plug_in = 0, rim_option = 0;
   std::size_t n = 0, n_rim = 0;
+  std::vector<double> truth;
   for (int frame = 0; frame < 3000; ++frame) {
     const double depth = press(rng), x0 = shift(rng), y0 = shift(rng);
-    tsn::PadMatrix counts = tsn::PadMatrix::Zero(14, 6);
-    std::vector<double> truth(84, 0.0);
-    for (int i = 0; i < 84; ++i) {
-      const taxel::Vec3d at = m.geometry.tactel(i / 6, i % 6);
-      truth[i] = depth - ((at.x() - x0) * (at.x() - x0) + (at.y() - y0) * (at.y() - y0)) / 0.08;
-      if (truth[i] <= 0) continue;  // not touched: no reading
-      const double k = std::round((truth[i] + m.sigma_normal * gauss(rng)) / m.depth_per_count());
-      counts(i / 6, i % 6) = static_cast<std::uint16_t>(k >= m.threshold ? std::min(k, 4095.0) : 0);
-    }
+    const tsn::PadMatrix counts = noisy_cap(m, depth, x0, y0, rng, gauss, truth);
     std::vector<taxel::Contact<double>> a, b, p;
     corrected.extract(counts, Eigen::Isometry3d::Identity(), 0.0, a);
     plain.extract(counts, Eigen::Isometry3d::Identity(), 0.0, b);
@@ -218,17 +233,10 @@ TEST_CASE("readings to contacts: the stated depth variances do not follow the re
   std::uniform_real_distribution<double> press(0.3e-3, 1.5e-3), shift(-1.7e-3, 1.7e-3);
   double plain = 0, weighted = 0, weights = 0, spread_lo = 1, spread_hi = 0;
   std::size_t n = 0;
+  std::vector<double> truth;
   for (int frame = 0; frame < 4000; ++frame) {
     const double depth = press(rng), x0 = shift(rng), y0 = shift(rng);
-    tsn::PadMatrix counts = tsn::PadMatrix::Zero(14, 6);
-    std::vector<double> truth(84, 0.0);
-    for (int i = 0; i < 84; ++i) {
-      const taxel::Vec3d at = m.geometry.tactel(i / 6, i % 6);
-      truth[i] = depth - ((at.x() - x0) * (at.x() - x0) + (at.y() - y0) * (at.y() - y0)) / 0.08;
-      if (truth[i] <= 0) continue;
-      const double k = std::round((truth[i] + m.sigma_normal * gauss(rng)) / m.depth_per_count());
-      counts(i / 6, i % 6) = static_cast<std::uint16_t>(k >= m.threshold ? std::min(k, 4095.0) : 0);
-    }
+    const tsn::PadMatrix counts = noisy_cap(m, depth, x0, y0, rng, gauss, truth);
     std::vector<taxel::Contact<double>> out;
     ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out);
     std::size_t k = 0;
