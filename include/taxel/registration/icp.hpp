@@ -374,8 +374,7 @@ class Icp {
     Isometry3d back = t;
     double back_rmse = previous_rmse;
     Outcome last{};
-    hints_.assign(active_->size(), kNoHint);  // a new stage: no previous matches
-    stable_.assign(active_->size(), Anchor{});
+    matches_.assign(active_->size(), Match{});  // a new stage: no previous matches
     for (int it = 0; it < cfg_.max_iterations; ++it) {
       const double rmse = correspond(target, t);
       if (pairs_.size() < need) {
@@ -437,34 +436,33 @@ class Icp {
       index::PointId id = 0;
       if (const auto approx = approximate_ ? target.field_nearest(ps) : std::nullopt) {
         id = *approx;
-      } else if (hints_[i] != kNoHint && (p - stable_[i].at).squaredNorm() < stable_[i].radius2) {
+      } else if (Match& m = matches_[i]; m.id != kNoHint && (p - m.at).squaredNorm() < m.radius2) {
         // Moved less than the stable radius of its last search: that match is still the
         // nearest, within the gate exactly when the search would find it there.
-        id = hints_[i];
+        id = m.id;
         if (!(index::squared_distance(pts[id], ps) <= gate * gate)) {
-          hints_[i] = kNoHint;
-          stable_[i] = Anchor{};
+          m = Match{};
           continue;
         }
       } else {
         // Exact, searched from the point's previous match: after a small update the match
         // moves little, so the ball it bounds holds few cells (the same answer as without).
         std::optional<index::Neighbor<S>> nb;
-        if (hints_[i] == kNoHint) {
+        double radius = 0.0;
+        if (m.id == kNoHint) {
           nb = target.nearest_within(ps, gate);
         } else if (!cfg_.keep_stable_matches) {
-          nb = target.nearest_within(ps, gate, hints_[i]);
-        } else if (const auto st = target.nearest_stable(ps, gate, hints_[i])) {
+          nb = target.nearest_within(ps, gate, m.id);
+        } else if (const auto st = target.nearest_stable(ps, gate, m.id)) {
           nb = st->nearest;
-          stable_[i] = Anchor{p, st->radius * st->radius};
+          radius = st->radius;
         }
         if (!nb) {
-          hints_[i] = kNoHint;
-          stable_[i] = Anchor{};
+          m = Match{};
           continue;
         }
         id = nb->id;
-        hints_[i] = id;
+        m = Match{id, p, radius * radius};
       }
       Correspondence c;
       c.p = p;
@@ -521,14 +519,15 @@ class Icp {
   bool approximate_ = false;
   std::vector<Correspondence> pairs_;
   std::vector<double> scratch_;
-  std::vector<index::PointId> hints_;  // each active point's last exact match, or kNoHint
-  // Where each active point was when its match was last searched, and the squared radius
-  // around there within which that match stays its nearest (0: search again).
-  struct Anchor {
+  // Each active point's last exact match (kNoHint: none), where the point was when that match
+  // was searched, and the squared radius around there within which it stays the nearest (0:
+  // search again).
+  struct Match {
+    index::PointId id = kNoHint;
     Vec3d at = Vec3d::Zero();
     double radius2 = 0.0;
   };
-  std::vector<Anchor> stable_;
+  std::vector<Match> matches_;
 };
 
 }  // namespace taxel::registration
