@@ -407,7 +407,11 @@ class ContactExtractor {
     refined_ = true;
     // Pass 1: the corrections at the refit.
     detail_solve(ata, 6, inv_diag, sol1);
-    for (std::size_t i = 0; i < count; ++i) correct(active_[i], fitted(sol1, active_[i]), true);
+    // (Only the per-pad contact reads the corrected depths' variances; see the model, step 1.)
+    const bool variances = options_.mode == ContactMode::per_pad;
+    for (std::size_t i = 0; i < count; ++i) {
+      correct(active_[i], fitted(sol1, active_[i]), variances);
+    }
     // The refit gives the per-tactel normals: its gradient at (X, Y) is
     // (q1 + 2 q3 X + q4 Y, q2 + q4 X + 2 q5 Y) per pitch, with variances v e' A^-1 e for
     // e = (0, 1, 0, 2X, Y, 0) and (0, 0, 1, 0, X, 2Y): two quadratic forms in X and Y, whose
@@ -571,7 +575,7 @@ class ContactExtractor {
   // An active tactel: its cell in the padded grid, its index, pad coordinates (pitch units from
   // the pad centre; monomials_ has them too, kept here beside the rest of what the loops read),
   // measured depth [m], Jensen factor h v / (2 sigma) of the refined correction [m], corrected
-  // depth's variance [m^2], plug-in correction [m] and reading.
+  // depth's variance [m^2] (read by the per-pad contact), plug-in correction [m] and reading.
   struct Active {
     std::size_t at, tactel;
     double x, y, measured, jensen, var, plug_in, pressure;
