@@ -45,11 +45,12 @@ struct Row {
   std::size_t confirmed_points = 0;
   sim::SurfaceError supported;  // confident points (>= 3 contacts, sigma across <= 0.3 mm)
   double ns_per_contact = 0.0;
+  std::vector<double> errors;  // signed distance of every point [m], by id (`keep_errors`)
 };
 
 template <class Policy, class Shape>
 Row fuse(const Shape& shape, const std::vector<Contact<double>>& contacts, std::size_t count,
-         const std::filesystem::path& ply, double radius) {
+         const std::filesystem::path& ply, double radius, bool keep_errors = false) {
   tf::ContactCloud<Policy, index::VoxelHash<double>> cloud({.association_radius = radius});
   cloud.reserve(count);
   const auto t0 = std::chrono::steady_clock::now();
@@ -70,6 +71,9 @@ Row fuse(const Shape& shape, const std::vector<Contact<double>>& contacts, std::
   r.supported = sim::surface_error(
       shape, cloud.to_point_cloud({3, std::numeric_limits<double>::infinity(), 0.3e-3}).points);
   r.confirmed_points = confirmed.size();
+  if (keep_errors) {
+    for (const Vec3d& x : pc.points) r.errors.push_back(shape.signed_distance(x));
+  }
   if (!ply.empty()) io::write_ply(ply.string(), pc);
   return r;
 }
@@ -92,6 +96,10 @@ struct Study {
   std::vector<double> contacts;                      // checkpoints
   std::vector<double> raw, average, kalman, surfel;  // RMS error [mm] at each checkpoint
   std::vector<double> average3, kalman3, surfel3;    // the same over the confident points
+  // Surfel's signed error of every point [m] at each checkpoint, by point id. A cloud only
+  // appends points and the stream's prefixes are fused alike, so the points of one checkpoint
+  // are the first ones of the next.
+  std::vector<std::vector<double>> surfel_errors;
 };
 
 // The stream of a study: several slides from random starts, so the cloud covers much of the
@@ -167,7 +175,8 @@ void curve_point(const Shape& shape, const std::vector<Contact<double>>& contact
   curve.raw[at] = 1e3 * fuse<tf::Raw<double>>(shape, contacts, k, {}, radius).m.error.rms;
   const Row a = fuse<tf::Average<double>>(shape, contacts, k, {}, radius);
   const Row kf = fuse<tf::Kalman<double>>(shape, contacts, k, {}, radius);
-  const Row sf = fuse<tf::Surfel<double>>(shape, contacts, k, {}, radius);
+  Row sf = fuse<tf::Surfel<double>>(shape, contacts, k, {}, radius, true);
+  curve.surfel_errors[at] = std::move(sf.errors);
   curve.average[at] = 1e3 * a.m.error.rms;
   curve.kalman[at] = 1e3 * kf.m.error.rms;
   curve.surfel[at] = 1e3 * sf.m.error.rms;
@@ -294,6 +303,7 @@ int main(int argc, char** argv) try {
                     &curve.average3, &curve.kalman3, &curve.surfel3}) {
       v->assign(checkpoints.size(), 0.0);
     }
+    curve.surfel_errors.resize(checkpoints.size());
     sim::SlidingConfig noise = aniso;
     noise.seed = kCurveSeeds[c];
     curve_streams[c] = study_stream(sim::Sphere(0.04), n, noise, true);
@@ -457,6 +467,30 @@ int main(int argc, char** argv) try {
       "mean of the seeds: largest rise %+.0f %% over every point, %+.0f %% over the "
       "confident points\n",
       100.0 * largest_rise(curve.surfel), 100.0 * largest_rise(curve.surfel3));
+  // Whether more contacts make the existing points worse: at each checkpoint, the RMS over the
+  // points the previous checkpoint had, then and now. (The RMS over every point also moves as
+  // the cloud grows into new regions, whose first points have few contacts; the first
+  // checkpoints hold 13-22 points, so their RMS alone varies by about 1 / sqrt(2 m), 15 %.)
+  std::printf(
+      "Surfel, the points of the previous checkpoint, RMS [mm] then > now (a filter's promise: "
+      "more contacts do not make a point worse):\n");
+  for (std::size_t c = 0; c < kCurves; ++c) {
+    const auto rms_of_first = [](const std::vector<double>& e, std::size_t m) {
+      double sum = 0;
+      for (std::size_t i = 0; i < m; ++i) sum += e[i] * e[i];
+      return m > 0 ? 1e3 * std::sqrt(sum / double(m)) : 0.0;
+    };
+    double rise = 0;
+    std::printf("seed %d:", int(kCurveSeeds[c]));
+    const auto& errors = curves[c].surfel_errors;
+    for (std::size_t k = 1; k < errors.size(); ++k) {
+      const std::size_t m = errors[k - 1].size();
+      const double then = rms_of_first(errors[k - 1], m), now = rms_of_first(errors[k], m);
+      rise = std::max(rise, now / then - 1.0);
+      std::printf("%s %zu pts %.3f > %.3f", k > 1 ? "," : "", m, then, now);
+    }
+    std::printf("  (largest rise %+.0f %%)\n", 100.0 * rise);
+  }
   std::printf("wrote %s/*.ply and %s/error_vs_contacts.svg\n", out.c_str(), out.c_str());
   return 0;
 } catch (const std::exception& e) {
