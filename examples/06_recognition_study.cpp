@@ -53,8 +53,8 @@ options:
   --seed S       synthesiser and evaluation seed (default 1)
   --out DIR      output folder (default recognition-study)
   --quick        5 subjects: a smoke run of every step
-  --threads N    folds, replications and noise levels on N threads (default 0: every core);
-                 the tables are the same for any N
+  --threads N    folds, replications, noise levels and each SVM's one-vs-rest problems on N
+                 threads (default 0: every core); the tables are the same for any N
   -h, --help     show this help
 )usage";
 
@@ -139,6 +139,7 @@ Lsvm make_lsvm() {
   // (the same C for both schemes).
   tl::LinearSvmConfig c;
   c.C = 0.01;
+  c.threads = g_threads;  // each fit's one-vs-rest problems too
   return Lsvm(tl::LinearSvm(c));
 }
 

@@ -164,13 +164,15 @@ Classifiers on feature arrays, with scikit-learn-like fit / predict / decision_f
 LinearSvm reproduces LIBLINEAR 2.3 (-s 1 / -s 3, one-vs-rest) and reads and writes its model
 files.)doc");
 
-  bind_classifier<ln::LinearSvm>(m, "LinearSvm",
-                                 "Linear SVM, LIBLINEAR's dual coordinate descent: loss 'l2' "
-                                 "(-s 1, default) or 'l1' (-s 3); C (-c), eps (-e), bias (-B), "
-                                 "class_weights {label: w} (-wi).")
+  bind_classifier<ln::LinearSvm>(
+      m, "LinearSvm",
+      "Linear SVM, LIBLINEAR's dual coordinate descent: loss 'l2' "
+      "(-s 1, default) or 'l1' (-s 3); C (-c), eps (-e), bias (-B), "
+      "class_weights {label: w} (-wi); threads trains the one-vs-rest problems at once (0: "
+      "every core; the model does not depend on it).")
       .def(py::init([](double C, const std::string& loss, double eps, double bias,
                        int max_iterations, bool shrinking, std::uint64_t seed,
-                       const std::map<int, double>& class_weights) {
+                       const std::map<int, double>& class_weights, unsigned threads) {
              ln::LinearSvmConfig c;
              c.C = C;
              c.loss = enum_from(loss, kLosses, "loss");
@@ -180,11 +182,13 @@ files.)doc");
              c.shrinking = shrinking;
              c.seed = seed;
              c.class_weights.assign(class_weights.begin(), class_weights.end());
+             c.threads = threads;
              return ln::LinearSvm(c);
            }),
            py::kw_only(), py::arg("C") = 1.0, py::arg("loss") = "l2", py::arg("eps") = 0.1,
            py::arg("bias") = -1.0, py::arg("max_iterations") = 1000, py::arg("shrinking") = true,
-           py::arg("seed") = 1, py::arg("class_weights") = std::map<int, double>{})
+           py::arg("seed") = 1, py::arg("class_weights") = std::map<int, double>{},
+           py::arg("threads") = 0u)
       .def_property_readonly(
           "coef_", [](const ln::LinearSvm& s) { return s.weights(); },
           "(n_problems, n_features) weights; one row for two classes")

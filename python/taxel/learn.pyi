@@ -85,8 +85,8 @@ class Lda:
 
 
 class LinearSvm:
-    """Linear SVM, LIBLINEAR's dual coordinate descent: loss 'l2' (-s 1, default) or 'l1' (-s 3); C (-c), eps (-e), bias (-B), class_weights {label: w} (-wi)."""
-    def __init__(self, *, C: float = 1.0, loss: str = 'l2', eps: float = 0.1, bias: float = -1.0, max_iterations: int = 1000, shrinking: bool = True, seed: int = 1, class_weights: typing.Dict[int, float] = {}) -> None: ...
+    """Linear SVM, LIBLINEAR's dual coordinate descent: loss 'l2' (-s 1, default) or 'l1' (-s 3); C (-c), eps (-e), bias (-B), class_weights {label: w} (-wi); threads trains the one-vs-rest problems at once (0: every core; the model does not depend on it)."""
+    def __init__(self, *, C: float = 1.0, loss: str = 'l2', eps: float = 0.1, bias: float = -1.0, max_iterations: int = 1000, shrinking: bool = True, seed: int = 1, class_weights: typing.Dict[int, float] = {}, threads: int = 0) -> None: ...
     @property
     def classes_(self) -> numpy.typing.NDArray[numpy.int32]: ...
     @property

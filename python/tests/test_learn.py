@@ -144,3 +144,7 @@ def test_threads_do_not_change_results(rng):
     a = learn.five_by_two_cv(learn.LinearSvm(), learn.Knn(), x, y, threads=1)
     b = learn.five_by_two_cv(learn.LinearSvm(), learn.Knn(), x, y, threads=2)
     np.testing.assert_array_equal(a.differences, b.differences)
+    s1 = learn.LinearSvm(threads=1).fit(x, y)
+    s3 = learn.LinearSvm(threads=3).fit(x, y)
+    assert s1.coef_.shape[0] == len(np.unique(y)) > 2
+    np.testing.assert_array_equal(s1.coef_, s3.coef_)

@@ -407,6 +407,44 @@ TEST_CASE("cross_validate and five_by_two_cv give the same results on any number
   }
 }
 
+TEST_CASE("LinearSvm trains its one-vs-rest problems on several threads to the same model",
+          "[learn][threads]") {
+  const Dataset d = taxel_test::blobs(60, 5, 8, 1.5, 33);
+  for (const SvmLoss loss : {SvmLoss::l2, SvmLoss::l1}) {
+    // A max_iterations low enough that some problems stop there: the status names the first.
+    for (const int iterations : {1000, 3}) {
+      LinearSvmConfig one{.loss = loss, .max_iterations = iterations, .record_objective = true};
+      one.threads = 1;
+      LinearSvmConfig many = one;
+      many.threads = 4;  // more threads than cores: problems still go out one at a time
+      LinearSvm a(one), b(many);
+      const Outcome oa = a.fit(d.view()), ob = b.fit(d.view());
+      CHECK(oa.status == ob.status);
+      CHECK(oa.message == ob.message);
+      REQUIRE(a.weights().rows() == 5);
+      CHECK(a.weights() == b.weights());
+      CHECK(a.bias_weights() == b.bias_weights());
+      CHECK(a.info().iterations == b.info().iterations);
+      CHECK(a.info().objective == b.info().objective);
+      CHECK(a.info().support_vectors == b.info().support_vectors);
+      CHECK(a.info().trace == b.info().trace);
+      CHECK(a.save() == b.save());
+      if (iterations == 3) {
+        CHECK(oa.status == Status::not_converged);
+        CHECK_THAT(oa.message, Contains("max_iterations = 3"));
+      }
+    }
+  }
+  // Each problem has its own generator: the first is seeded by `seed` itself, so two classes
+  // give the model a single generator seeded by `seed` would.
+  const Dataset two = taxel_test::blobs(50, 2, 6, 1.0, 8);
+  LinearSvm x(LinearSvmConfig{.seed = 7}), y(LinearSvmConfig{.seed = 8});
+  REQUIRE(x.fit(two.view()).ok());
+  REQUIRE(y.fit(two.view()).ok());
+  CHECK(x.weights().rows() == 1);
+  CHECK_FALSE(x.weights() == y.weights());  // the seed is used
+}
+
 TEST_CASE("Student t CDF agrees with closed forms, quantiles give the 5x2cv thresholds",
           "[learn]") {
   for (const double t : {-3.0, -0.7, 0.0, 0.4, 1.3, 2.5, 8.0}) {

@@ -105,7 +105,9 @@ struct CvOptions {
   double snr_db = std::numeric_limits<double>::infinity();  ///< feature noise; inf = none
   NoiseTarget noise_target = NoiseTarget::test_only;        ///< where the noise goes
   /// Folds trained at once, each on its own thread (0: every core). The report does not depend
-  /// on it: the noise is drawn in fold order before training.
+  /// on it: the noise is drawn in fold order before training. A classifier may train on
+  /// threads of its own too (`LinearSvmConfig::threads`), so that the last folds do not leave
+  /// cores idle.
   unsigned threads = 0;
   ProgressFn progress{};  ///< called after each fold (from the thread that ran it, serialised)
 };

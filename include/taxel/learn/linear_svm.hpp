@@ -20,6 +20,7 @@
 
 #include "taxel/core/deferred.hpp"
 #include "taxel/core/error.hpp"
+#include "taxel/core/parallel.hpp"
 #include "taxel/core/status.hpp"
 #include "taxel/learn/dataset.hpp"
 
@@ -33,18 +34,24 @@ enum class SvmLoss {
 
 /// Options of LinearSvm. The defaults are LIBLINEAR's (`train` with no options).
 struct LinearSvmConfig {
-  SvmLoss loss = SvmLoss::l2;     ///< -s 1 or -s 3
-  double C = 1.0;                 ///< -c: cost of constraint violation, > 0
-  double eps = 0.1;               ///< -e: stop when max - min projected gradient <= eps, > 0
-  double bias = -1.0;             ///< -B: < 0 for none; >= 0 appends this constant feature
-  int max_iterations = 1000;      ///< outer iterations per binary problem (LIBLINEAR 2.3: 1000)
-  bool shrinking = true;          ///< skip variables at a bound whose gradient points outward
-  std::uint64_t seed = 1;         ///< seed of the per-iteration random permutation
+  SvmLoss loss = SvmLoss::l2;  ///< -s 1 or -s 3
+  double C = 1.0;              ///< -c: cost of constraint violation, > 0
+  double eps = 0.1;            ///< -e: stop when max - min projected gradient <= eps, > 0
+  double bias = -1.0;          ///< -B: < 0 for none; >= 0 appends this constant feature
+  int max_iterations = 1000;   ///< outer iterations per binary problem (LIBLINEAR 2.3: 1000)
+  bool shrinking = true;       ///< skip variables at a bound whose gradient points outward
+  /// Seed of the per-iteration random permutation. Each binary problem of one-vs-rest draws
+  /// from its own generator (the first, and the only one of two classes, from `seed` itself),
+  /// so the model does not depend on `threads`.
+  std::uint64_t seed = 1;
   bool record_objective = false;  ///< keep the dual objective after every outer iteration
   /// -w<label> weight: the cost of a class is weight * C (LIBLINEAR's weighted C: in
   /// one-vs-rest the class's own samples cost weight_k * C and the rest C; with two classes
   /// each class costs its own weight * C). Classes not listed weigh 1. Weights > 0.
   std::vector<std::pair<int, double>> class_weights{};
+  /// Binary problems of one-vs-rest trained at once, each on its own thread (0: every core;
+  /// more threads than classes are not started). The model is the same for any value.
+  unsigned threads = 0;
 };
 
 /// What training did, per binary problem (one per class in one-vs-rest, one for two classes).
@@ -110,32 +117,40 @@ class LinearSvm {
     FeatureMatrix w(nr_w, dims);
     VectorXd wb(nr_w);
     LinearSvmTrainInfo info;
-    std::mt19937_64 rng(cfg_.seed);
-    std::vector<signed char> sign(static_cast<std::size_t>(n));
-    Outcome out;
-    for (int k = 0; k < nr_w; ++k) {
+    const auto problems = static_cast<std::size_t>(nr_w);
+    info.iterations.resize(problems);
+    info.objective.resize(problems);
+    info.support_vectors.resize(problems);
+    info.trace.resize(problems);
+    // The binary problems are independent: each writes its own row and slots.
+    parallel_for(problems, cfg_.threads, [&](std::size_t k) {
+      std::vector<signed char> sign(static_cast<std::size_t>(n));
       for (Eigen::Index i = 0; i < n; ++i) {
         sign[static_cast<std::size_t>(i)] = d.y[static_cast<std::size_t>(i)] == classes[k] ? 1 : -1;
       }
       VectorXd wk = VectorXd::Zero(dims);
       double wbk = 0.0;
-      std::vector<double> trace;
-      const double cp = cost_of(classes[static_cast<std::size_t>(k)]);
+      // Problem k's generator: `seed` for the first, then seeds a golden-ratio step apart.
+      std::mt19937_64 rng(cfg_.seed + 0x9e3779b97f4a7c15ULL * k);
+      const double cp = cost_of(classes[k]);
       const double cn = nr_class == 2 ? cost_of(classes[1]) : cfg_.C;
-      const Solve s =
-          solve(d.x, sign, qd_base, cp, cn, wk, wbk, rng, cfg_.record_objective ? &trace : nullptr);
-      w.row(k) = wk.transpose();
-      wb(k) = wbk;
-      info.iterations.push_back(s.iterations);
-      info.objective.push_back(s.objective);
-      info.support_vectors.push_back(s.support_vectors);
-      info.trace.push_back(std::move(trace));
-      if (s.iterations >= cfg_.max_iterations && out.ok()) {
+      const Solve s = solve(d.x, sign, qd_base, cp, cn, wk, wbk, rng,
+                            cfg_.record_objective ? &info.trace[k] : nullptr);
+      w.row(static_cast<Eigen::Index>(k)) = wk.transpose();
+      wb(static_cast<Eigen::Index>(k)) = wbk;
+      info.iterations[k] = s.iterations;
+      info.objective[k] = s.objective;
+      info.support_vectors[k] = s.support_vectors;
+    });
+    Outcome out;
+    for (std::size_t k = 0; k < problems; ++k) {
+      if (info.iterations[k] >= cfg_.max_iterations) {
         out = Outcome{Status::not_converged,
                       "LinearSvm: the binary problem of class " + std::to_string(classes[k]) +
                           " reached max_iterations = " + std::to_string(cfg_.max_iterations) +
                           " before the projected gradient spread fell to eps; scale the "
                           "features or raise eps"};
+        break;
       }
     }
     if (!w.allFinite() || !wb.allFinite()) {
