@@ -155,37 +155,36 @@ BENCHMARK(BM_LiblinearPredict)->Arg(11)->Arg(1035);
 #endif
 
 // Cross-validation of LinearSvm on the 1035-feature problem (args: folds, threads with 0 = every
-// core, for the folds and for each fold's one-vs-rest problems alike) and the 5x2cv test (10
+// core, LinearSvm's own threads; threads 1 caps those at one too) and the 5x2cv test (10
 // rounds) of LinearSvm against Lda. Folds alone would cap the speed-up of 5 folds on 2 cores at
 // 5 / 3 = 1.67; with each fold's 4 binary problems on threads of their own, the 20 problems
 // balance over the cores.
 void BM_CrossValidate(benchmark::State& state) {
   const Problem& p = data_for(1035);
-  const auto threads = static_cast<unsigned>(state.range(1));
-  const tl::CvOptions opt{.folds = static_cast<int>(state.range(0)), .threads = threads};
-  tl::LinearSvmConfig svm;
-  svm.threads = threads;
+  const tl::CvOptions opt{.folds = static_cast<int>(state.range(0)),
+                          .threads = static_cast<unsigned>(state.range(1))};
+  tl::LinearSvmConfig svm;  // the third argument: its threads (1: the folds alone)
+  svm.threads = static_cast<unsigned>(state.range(2));
   double acc = 0.0;
   for (auto _ : state) acc = tl::cross_validate(tl::LinearSvm(svm), p.train.view(), opt).accuracy;
   state.counters["cv_accuracy_pct"] = 100.0 * acc;
   state.counters["threads"] = taxel::resolve_threads(opt.threads);
 }
 BENCHMARK(BM_CrossValidate)
-    ->Args({5, 1})
-    ->Args({5, 0})
-    ->Args({10, 1})
-    ->Args({10, 0})
+    ->Args({5, 1, 0})
+    ->Args({5, 0, 0})
+    ->Args({5, 0, 1})
+    ->Args({10, 1, 0})
+    ->Args({10, 0, 0})
+    ->Args({10, 0, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 void BM_FiveByTwo(benchmark::State& state) {
   const Problem& p = data_for(11);
   const tl::FiveByTwoOptions opt{.threads = static_cast<unsigned>(state.range(0))};
-  tl::LinearSvmConfig svm;
-  svm.threads = opt.threads;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(
-        tl::five_by_two_cv(tl::LinearSvm(svm), tl::Lda{}, p.train.view(), opt).t);
+    benchmark::DoNotOptimize(tl::five_by_two_cv(tl::LinearSvm{}, tl::Lda{}, p.train.view(), opt).t);
   }
   state.counters["threads"] = taxel::resolve_threads(opt.threads);
 }

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <memory>
+#include <mutex>
 #include <numbers>
 #include <set>
 #include <taxel/image/recognizer.hpp>
@@ -443,6 +446,52 @@ TEST_CASE("LinearSvm trains its one-vs-rest problems on several threads to the s
   REQUIRE(y.fit(two.view()).ok());
   CHECK(x.weights().rows() == 1);
   CHECK_FALSE(x.weights() == y.weights());  // the seed is used
+}
+
+namespace {
+// A Knn that records the training threads each fit was given (ThreadedTraining).
+struct ThreadProbe : Knn {
+  unsigned own = 0;
+  std::shared_ptr<std::vector<unsigned>> seen = std::make_shared<std::vector<unsigned>>();
+  std::shared_ptr<std::mutex> mutex = std::make_shared<std::mutex>();
+  [[nodiscard]] unsigned threads() const noexcept { return own; }
+  void set_threads(unsigned n) noexcept { own = n; }
+  Outcome fit(const DatasetView& d) {
+    {
+      const std::lock_guard<std::mutex> lock(*mutex);
+      seen->push_back(own);
+    }
+    return Knn::fit(d);
+  }
+};
+static_assert(ThreadedTraining<ThreadProbe>);
+static_assert(ThreadedTraining<LinearSvm>);
+static_assert(ThreadedTraining<Scaled<StandardScaler, LinearSvm>>);
+static_assert(!ThreadedTraining<Scaled<StandardScaler, Knn>>);
+}  // namespace
+
+TEST_CASE("cross_validate and five_by_two_cv cap a classifier's own threads at theirs",
+          "[learn][threads]") {
+  const Dataset d = taxel_test::blobs(20, 3, 4, 1.0, 5);
+  // (the classifier's own, the run's) -> what each fit gets: at most the run's, 0 meaning all.
+  const std::vector<std::array<unsigned, 3>> cases = {{0, 1, 1}, {0, 0, 0}, {5, 3, 3},
+                                                      {2, 3, 2}, {0, 2, 2}, {4, 0, 4}};
+  for (const auto& [own, run, expected] : cases) {
+    INFO("own " << own << ", run " << run);
+    ThreadProbe probe;
+    probe.own = own;
+    REQUIRE(cross_validate(probe, d.view(), CvOptions{.folds = 4, .threads = run}).ok());
+    CHECK(*probe.seen == std::vector<unsigned>(4, expected));
+    probe.seen->clear();
+    // (Knn against Knn: equal errors, so the t statistic is undefined; the fits all ran.)
+    (void)five_by_two_cv(probe, Knn{}, d.view(), FiveByTwoOptions{.threads = run});
+    CHECK(*probe.seen == std::vector<unsigned>(10, expected));
+  }
+  // Scaled passes them to the classifier it wraps.
+  Scaled<StandardScaler, LinearSvm> scaled(LinearSvm(LinearSvmConfig{.threads = 6}));
+  CHECK(scaled.threads() == 6);
+  scaled.set_threads(2);
+  CHECK(scaled.classifier().threads() == 2);
 }
 
 TEST_CASE("Student t CDF agrees with closed forms, quantiles give the 5x2cv thresholds",

@@ -31,4 +31,14 @@ concept Classifier = std::copy_constructible<C> &&
   { cc.dims() } -> std::convertible_to<Eigen::Index>;
 };
 
+/// A classifier that trains on threads of its own (`LinearSvm`: its one-vs-rest problems):
+/// `threads()` is how many it may use (0: every core), `set_threads(n)` changes that.
+/// Cross-validation and the 5x2cv test cap it at their own `threads`, so that `threads = 1`
+/// runs everything on the calling thread.
+template <class C>
+concept ThreadedTraining = requires(C& c, const C& cc, unsigned n) {
+  { cc.threads() } -> std::convertible_to<unsigned>;
+  c.set_threads(n);
+};
+
 }  // namespace taxel::learn

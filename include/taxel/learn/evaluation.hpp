@@ -105,9 +105,9 @@ struct CvOptions {
   double snr_db = std::numeric_limits<double>::infinity();  ///< feature noise; inf = none
   NoiseTarget noise_target = NoiseTarget::test_only;        ///< where the noise goes
   /// Folds trained at once, each on its own thread (0: every core). The report does not depend
-  /// on it: the noise is drawn in fold order before training. A classifier may train on
-  /// threads of its own too (`LinearSvmConfig::threads`), so that the last folds do not leave
-  /// cores idle.
+  /// on it: the noise is drawn in fold order before training. A classifier that trains on
+  /// threads of its own (ThreadedTraining: `LinearSvm`) keeps them, so that the last folds do
+  /// not leave cores idle, but at most this many: 1 runs everything on the calling thread.
   unsigned threads = 0;
   ProgressFn progress{};  ///< called after each fold (from the thread that ran it, serialised)
 };
@@ -148,10 +148,16 @@ Split make_split(const DatasetView& d, std::span<const int> fold, int f, double 
 }
 
 /// Trains a copy of `prototype` on the split and writes its test predictions to
-/// predicted[test row]. Returns the training outcome.
+/// predicted[test row]. Returns the training outcome. A classifier with threads of its own
+/// gets at most `threads` of them (0: no cap; see ThreadedTraining).
 template <Classifier C>
-Outcome train_and_test(const C& prototype, const Split& s, std::vector<int>& predicted) {
+Outcome train_and_test(const C& prototype, const Split& s, std::vector<int>& predicted,
+                       unsigned threads) {
   C model = prototype;
+  if constexpr (ThreadedTraining<C>) {
+    const unsigned own = model.threads();
+    if (threads > 0 && (own == 0 || own > threads)) model.set_threads(threads);
+  }
   Outcome o = model.fit(s.train.view());
   if (o.status != Status::ok && o.status != Status::not_converged) return o;
   for (std::size_t r = 0; r < s.test_rows.size(); ++r) {
@@ -222,7 +228,7 @@ CvReport cross_validate(const C& prototype, const DatasetView& d, const CvOption
       splits[f] = detail::make_split(d, rep.fold, static_cast<int>(f), opt.snr_db, opt.noise_target,
                                      rng);  // draws nothing without noise
     }
-    outcomes[f] = detail::train_and_test(prototype, splits[f], rep.predicted);
+    outcomes[f] = detail::train_and_test(prototype, splits[f], rep.predicted, opt.threads);
     splits[f] = {};  // free the fold's copy of the data as soon as it is done
     progress.step();
   });
@@ -262,7 +268,10 @@ struct FiveByTwoOptions {
   bool grouped = false;    ///< keep each group in one half
   double snr_db = std::numeric_limits<double>::infinity();  ///< feature noise; inf = none
   NoiseTarget noise_target = NoiseTarget::test_only;        ///< where the noise goes
-  unsigned threads = 0;   ///< rounds run at once, each on its own thread (0: every core)
+  /// Rounds run at once, each on its own thread (0: every core); also the most threads a
+  /// classifier with threads of its own (ThreadedTraining) gets: 1 runs everything on the
+  /// calling thread.
+  unsigned threads = 0;
   ProgressFn progress{};  ///< called after each of the 10 train/test rounds (serialised)
 };
 
@@ -306,8 +315,8 @@ FiveByTwoResult five_by_two_cv(const A& a, const B& b, const DatasetView& d,
     const detail::Split split = detail::make_split(d, fold, f, opt.snr_db, opt.noise_target, noise);
     std::vector<int> pred_a(d.y.size()), pred_b(d.y.size());
     Round& r = rounds[k];
-    r.a = detail::train_and_test(a, split, pred_a);
-    r.b = detail::train_and_test(b, split, pred_b);
+    r.a = detail::train_and_test(a, split, pred_a, opt.threads);
+    r.b = detail::train_and_test(b, split, pred_b, opt.threads);
     std::size_t wrong_a = 0, wrong_b = 0;
     for (const std::size_t i : split.test_rows) {
       wrong_a += pred_a[i] != d.y[i] ? 1 : 0;

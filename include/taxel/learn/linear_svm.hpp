@@ -226,6 +226,10 @@ class LinearSvm {
   [[nodiscard]] Eigen::Index dims() const noexcept { return w_.cols(); }
   /// Weight vectors, one row per binary problem (1 row for two classes).
   [[nodiscard]] const FeatureMatrix& weights() const noexcept { return w_; }
+  /// Threads `fit` may train on (LinearSvmConfig::threads; the ThreadedTraining concept).
+  [[nodiscard]] unsigned threads() const noexcept { return cfg_.threads; }
+  /// Changes them for the next `fit`; the model does not depend on the count.
+  void set_threads(unsigned threads) noexcept { cfg_.threads = threads; }
   /// Weight of the bias feature per binary problem; the intercept is `bias() * bias_weights()`.
   [[nodiscard]] const Eigen::VectorXd& bias_weights() const noexcept { return wb_; }
   /// The bias feature value (< 0: none).

@@ -170,6 +170,13 @@ class Scaled {
   [[nodiscard]] Eigen::Index dims() const noexcept { return classifier_.dims(); }
   [[nodiscard]] const S& scaler() const noexcept { return scaler_; }
   [[nodiscard]] const C& classifier() const noexcept { return classifier_; }
+  /// The wrapped classifier's training threads, when it has them (ThreadedTraining).
+  [[nodiscard]] unsigned threads() const noexcept requires ThreadedTraining<C> {
+    return classifier_.threads();
+  }
+  void set_threads(unsigned threads) noexcept requires ThreadedTraining<C> {
+    classifier_.set_threads(threads);
+  }
 
  private:
   S scaler_;
