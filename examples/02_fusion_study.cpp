@@ -43,6 +43,8 @@ struct Row {
   sim::ReconstructionMetrics m;
   sim::SurfaceError confirmed;  // points seen at least 5 times
   std::size_t confirmed_points = 0;
+  sim::SurfaceError sparse;  // the other points: one to four contacts
+  std::size_t sparse_points = 0;
   sim::SurfaceError supported;  // confident points (>= 3 contacts, sigma across <= 0.3 mm)
   double ns_per_contact = 0.0;
   std::vector<double> errors;  // signed distance of every point [m], by id (`keep_errors`)
@@ -61,11 +63,13 @@ Row fuse(const Shape& shape, const std::vector<Contact<double>>& contacts, std::
                      static_cast<double>(count);
   const PointCloud<double> pc = cloud.to_point_cloud();
   r.m = sim::reconstruction_metrics(shape, pc.points, count, {.coverage_samples = 5000});
-  std::vector<Vec3d> confirmed;
+  std::vector<Vec3d> confirmed, sparse;
   for (std::size_t i = 0; i < pc.size(); ++i) {
-    if (pc.field("observations")->values[i] >= 5) confirmed.push_back(pc.points[i]);
+    (pc.field("observations")->values[i] >= 5 ? confirmed : sparse).push_back(pc.points[i]);
   }
   r.confirmed = sim::surface_error(shape, confirmed);
+  r.sparse = sim::surface_error(shape, sparse);
+  r.sparse_points = sparse.size();
   // Confident points: at least 3 contacts, and across the surface as certain as one fingertip
   // contact (0.3 mm); a point only the palm pad (1.5 mm) has seen does not count yet.
   r.supported = sim::surface_error(
@@ -101,6 +105,34 @@ struct Study {
   // are the first ones of the next.
   std::vector<std::vector<double>> surfel_errors;
 };
+
+// The largest rise of a series over its lowest earlier value (0 when it never rises).
+double largest_rise(const std::vector<double>& v) {
+  double rise = 0, lowest = v.empty() ? 0.0 : v[0];
+  for (const double x : v) {
+    rise = std::max(rise, x / lowest - 1.0);
+    lowest = std::min(lowest, x);
+  }
+  return rise;
+}
+
+// RMS [mm] of the first `m` of a cloud's signed errors [m].
+double rms_of_first(const std::vector<double>& e, std::size_t m) {
+  double sum = 0;
+  for (std::size_t i = 0; i < m; ++i) sum += e[i] * e[i];
+  return m > 0 ? 1e3 * std::sqrt(sum / double(m)) : 0.0;
+}
+
+// The largest rise, from one checkpoint to the next, of the RMS over the points the earlier
+// one had (a cloud only appends points, so they are its first ones in the later cloud).
+double largest_rise_of_kept_points(const std::vector<std::vector<double>>& errors) {
+  double rise = 0;
+  for (std::size_t k = 1; k < errors.size(); ++k) {
+    const std::size_t m = errors[k - 1].size();
+    rise = std::max(rise, rms_of_first(errors[k], m) / rms_of_first(errors[k - 1], m) - 1.0);
+  }
+  return rise;
+}
 
 // The stream of a study: several slides from random starts, so the cloud covers much of the
 // object. With two pads (`mixed`), the fingertip and the palm pad explore at the same time:
@@ -194,6 +226,12 @@ struct PadLine {
   std::string text;
   bool surfel_ahead = false;
   bool surfel_ahead_supported = false;  // over the points of at least 5 contacts
+  bool surfel_more_sparse = false;      // more points of under 5 contacts than averaging
+  // Surfel against contacts (prefixes of 1/64, 1/32, .. of the stream, then all of it): the
+  // largest rise of the RMS over every point, and over the points of the previous checkpoint.
+  double rise_every = 0, rise_kept = 0;
+  std::string name;
+  int seed = 0;
 };
 
 template <class Shape>
@@ -215,7 +253,16 @@ PadLine pad_study(const char* name, const Shape& shape, bool quick, sim::Contact
   const Row raw = fuse<tf::Raw<double>>(shape, contacts, contacts.size(), {}, kGate);
   const Row avg = fuse<tf::Average<double>>(shape, contacts, contacts.size(), {}, kGate);
   const Row kal = fuse<tf::Kalman<double>>(shape, contacts, contacts.size(), {}, kGate);
-  const Row sur = fuse<tf::Surfel<double>>(shape, contacts, contacts.size(), {}, kGate);
+  Row sur = fuse<tf::Surfel<double>>(shape, contacts, contacts.size(), {}, kGate, true);
+  std::vector<double> every;
+  std::vector<std::vector<double>> errors;
+  for (int k = 6; k >= 1; --k) {
+    Row r = fuse<tf::Surfel<double>>(shape, contacts, contacts.size() >> k, {}, kGate, true);
+    every.push_back(r.m.error.rms);
+    errors.push_back(std::move(r.errors));
+  }
+  every.push_back(sur.m.error.rms);
+  errors.push_back(std::move(sur.errors));
   const auto cell = [](const Row& r) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%6.3f %+7.3f", 1e3 * r.m.error.rms,
@@ -225,10 +272,17 @@ PadLine pad_study(const char* name, const Shape& shape, bool quick, sim::Contact
   PadLine out;
   out.surfel_ahead = sur.m.error.rms < avg.m.error.rms;
   out.surfel_ahead_supported = sur.confirmed.rms < avg.confirmed.rms;
-  appendf(out.text, "%-26s %-10s %4d %8zu | %s | %s | %s | %s | %6.3f %6.3f%s\n", name,
-          mode == sim::ContactMode::per_tactel ? "per tactel" : "per pad", int(seed),
+  out.surfel_more_sparse = sur.sparse_points > avg.sparse_points;
+  out.name = name;
+  out.seed = int(seed);
+  out.rise_every = largest_rise(every);
+  out.rise_kept = largest_rise_of_kept_points(errors);
+  appendf(out.text,
+          "%-26s %-10s %4d %8zu | %s | %s | %s | %s | %6.3f %6.3f | %3zu %6.3f %3zu %6.3f%s\n",
+          name, mode == sim::ContactMode::per_tactel ? "per tactel" : "per pad", int(seed),
           contacts.size(), cell(raw).c_str(), cell(avg).c_str(), cell(kal).c_str(),
-          cell(sur).c_str(), 1e3 * avg.confirmed.rms, 1e3 * sur.confirmed.rms,
+          cell(sur).c_str(), 1e3 * avg.confirmed.rms, 1e3 * sur.confirmed.rms, avg.sparse_points,
+          1e3 * avg.sparse.rms, sur.sparse_points, 1e3 * sur.sparse.rms,
           out.surfel_ahead ? "" : "  (average ahead)");
   return out;
 }
@@ -380,11 +434,11 @@ int main(int argc, char** argv) try {
       "Pad model: a 14x6 DSA-like pad at 3.4 mm (12-bit readings, 0.3 mm depth noise, 0.2 mm and "
       "0.02 rad pose noise) slides, grasps (3 fingers x 2 pads) and palpates; gate 4 mm; each cell "
       "RMS and signed (outside minus inside) error in mm\n");
-  std::printf("%-26s %-10s %4s %8s | %-15s | %-15s | %-15s | %-16s | %s\n", "shape", "contacts",
-              "seed", "", "raw rms/signed", "average", "kalman", "surfel (default)",
-              "n>=5: average surfel");
+  std::printf("%-26s %-10s %4s %8s | %-15s | %-15s | %-15s | %-16s | %s | %s\n", "shape",
+              "contacts", "seed", "", "raw rms/signed", "average", "kalman", "surfel (default)",
+              "n>=5: average surfel", "n<5: points, rms: average  surfel");
   // Rows by mode, then shape, then seed (the jobs are by shape, then mode, then seed).
-  int surfel_wins = 0, surfel_wins_supported = 0;
+  int surfel_wins = 0, surfel_wins_supported = 0, behind = 0, behind_more_sparse = 0;
   for (std::size_t mode = 0; mode < 2; ++mode) {
     for (std::size_t shape = 0; shape < pads.size() / 6; ++shape) {
       for (std::size_t seed = 0; seed < 3; ++seed) {
@@ -392,6 +446,8 @@ int main(int argc, char** argv) try {
         std::fputs(l.text.c_str(), stdout);
         surfel_wins += l.surfel_ahead ? 1 : 0;
         surfel_wins_supported += l.surfel_ahead_supported ? 1 : 0;
+        behind += l.surfel_ahead ? 0 : 1;
+        behind_more_sparse += !l.surfel_ahead && l.surfel_more_sparse ? 1 : 0;
       }
     }
   }
@@ -399,10 +455,37 @@ int main(int argc, char** argv) try {
       "Surfel (the default) ahead of averaging in %d of %zu shape x mode x seed runs over every "
       "point, and in %d of %zu over the points of at least 5 contacts (per pad, most of the RMS "
       "over every point comes from the few points of one or two contacts, whose error is a raw "
-      "contact's). Averaging lands inside a curved surface by the chord sag, Kalman outside by "
-      "nearly as much; Surfel removes the sag with the curvature it fits to the contacts' "
-      "normals.\n\n",
-      surfel_wins, pads.size(), surfel_wins_supported, pads.size());
+      "contact's; where Surfel is behind over every point, it holds more such points than "
+      "averaging in %d of %d runs). Averaging lands inside a curved surface by the chord sag, "
+      "Kalman outside by nearly as much; Surfel removes the sag with the curvature it fits to the "
+      "contacts' normals.\n\n",
+      surfel_wins, pads.size(), surfel_wins_supported, pads.size(), behind_more_sparse, behind);
+  std::printf(
+      "Pad model, Surfel against contacts (the stream's first 1/64, 1/32, .., 1/2, then all of "
+      "it; slides, then grasps, then palpation): the largest rise of the RMS over every point "
+      "over an earlier checkpoint, and of the RMS over the points of the previous checkpoint, "
+      "then and now\n");
+  for (std::size_t mode = 0; mode < 2; ++mode) {
+    double worst_every = 0, worst_kept = 0;
+    for (std::size_t shape = 0; shape < pads.size() / 6; ++shape) {
+      std::printf("%-26s %-10s", pads[shape * 6 + mode * 3].name.c_str(),
+                  mode == 0 ? "per tactel" : "per pad");
+      for (std::size_t seed = 0; seed < 3; ++seed) {
+        const PadLine& l = pads[shape * 6 + mode * 3 + seed];
+        std::printf(" | seed %d: every point %+5.0f %%, kept points %+4.0f %%", l.seed,
+                    100.0 * l.rise_every, 100.0 * l.rise_kept);
+        worst_every = std::max(worst_every, l.rise_every);
+        worst_kept = std::max(worst_kept, l.rise_kept);
+      }
+      std::printf("\n");
+    }
+    std::printf("%s: largest rise %+.0f %% over every point, %+.0f %% over kept points\n",
+                mode == 0 ? "per tactel" : "per pad", 100.0 * worst_every, 100.0 * worst_kept);
+  }
+  std::printf(
+      "The RMS over every point follows which regions the cloud has reached: grasps and light "
+      "touches start points of few contacts. Over the points already there it rises most where "
+      "later contacts reach them across an edge (the box's, the cone's, the cylinder's rims).\n\n");
 
   // The mean over the seeds of every series.
   Study curve = curves[0];
@@ -446,14 +529,6 @@ int main(int argc, char** argv) try {
   }
   // Each seed's Surfel series, every point and confident points, and the largest rise of each
   // over an earlier checkpoint.
-  const auto largest_rise = [](const std::vector<double>& v) {
-    double rise = 0, lowest = v.empty() ? 0.0 : v[0];
-    for (const double x : v) {
-      rise = std::max(rise, x / lowest - 1.0);
-      lowest = std::min(lowest, x);
-    }
-    return rise;
-  };
   for (std::size_t c = 0; c < kCurves; ++c) {
     for (const auto& [name, series] : {std::pair{"every point", &Study::surfel},
                                        std::pair{"confident points", &Study::surfel3}}) {
@@ -475,21 +550,14 @@ int main(int argc, char** argv) try {
       "Surfel, the points of the previous checkpoint, RMS [mm] then > now (a filter's promise: "
       "more contacts do not make a point worse):\n");
   for (std::size_t c = 0; c < kCurves; ++c) {
-    const auto rms_of_first = [](const std::vector<double>& e, std::size_t m) {
-      double sum = 0;
-      for (std::size_t i = 0; i < m; ++i) sum += e[i] * e[i];
-      return m > 0 ? 1e3 * std::sqrt(sum / double(m)) : 0.0;
-    };
-    double rise = 0;
     std::printf("seed %d:", int(kCurveSeeds[c]));
     const auto& errors = curves[c].surfel_errors;
     for (std::size_t k = 1; k < errors.size(); ++k) {
       const std::size_t m = errors[k - 1].size();
-      const double then = rms_of_first(errors[k - 1], m), now = rms_of_first(errors[k], m);
-      rise = std::max(rise, now / then - 1.0);
-      std::printf("%s %zu pts %.3f > %.3f", k > 1 ? "," : "", m, then, now);
+      std::printf("%s %zu pts %.3f > %.3f", k > 1 ? "," : "", m, rms_of_first(errors[k - 1], m),
+                  rms_of_first(errors[k], m));
     }
-    std::printf("  (largest rise %+.0f %%)\n", 100.0 * rise);
+    std::printf("  (largest rise %+.0f %%)\n", 100.0 * largest_rise_of_kept_points(errors));
   }
   std::printf("wrote %s/*.ply and %s/error_vs_contacts.svg\n", out.c_str(), out.c_str());
   return 0;
