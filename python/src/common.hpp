@@ -137,14 +137,16 @@ inline void raise_unless_ok(const Outcome& o, bool allow_not_converged = false) 
 template <class E, std::size_t N>
 E enum_from(std::string_view name, const std::pair<std::string_view, E> (&names)[N],
             const char* what) {
+  // Appended piece by piece: GCC 12 at -O3 without LTO flags `"'" + std::string(n)` with a
+  // bogus -Wrestrict (GCC bug 105329).
   std::string known;
   for (const auto& [n, e] : names) {
     if (n == name) return e;
-    known += known.empty() ? "" : ", ";
-    known += "'" + std::string(n) + "'";
+    known.append(known.empty() ? "'" : ", '").append(n).append("'");
   }
-  throw py::value_error(std::string(what) + ": unknown value '" + std::string(name) +
-                        "' (expected one of " + known + ")");
+  std::string message(what);
+  message.append(": unknown value '").append(name).append("' (expected one of ").append(known);
+  throw py::value_error(message.append(")"));
 }
 
 /// The name of `e` among `names`.
