@@ -393,6 +393,12 @@ TEST_CASE("Sessions: recorded through the device, replayed byte-exact, checked",
     CHECK(f->device_time_ms == want.device_time_ms);
     CHECK((f->matrices[2] == want.matrices[2]).all());
   }
+  // The emulator streams on its own thread, so a read of the live device may have carried a
+  // frame past the fifth before the stop (more often on a loaded machine): the sections below
+  // compare with what the recording holds, not with 5.
+  int recorded = static_cast<int>(live.size());
+  while (replay.read_frame()) ++recorded;
+  REQUIRE(recorded >= 5);
 
   SECTION("a host that writes something else is caught") {
     td::ReplayTransport r(parsed);
@@ -412,7 +418,7 @@ TEST_CASE("Sessions: recorded through the device, replayed byte-exact, checked",
     again.start();
     int frames = 0;
     while (again.read_frame()) ++frames;
-    CHECK(frames == 5);
+    CHECK(frames == recorded);
     const std::string why =
         td::replay_shortfall(again.transport(), again.unparsed_bytes(), prefix.error);
     CHECK_THAT(why, Catch::Contains("the chunks before it were replayed"));
@@ -440,7 +446,7 @@ TEST_CASE("Sessions: recorded through the device, replayed byte-exact, checked",
     } catch (const std::exception&) {
       // A flipped handshake chunk fails loudly already; only a silent stall needs the check.
     }
-    CHECK(frames < 5);
+    CHECK(frames < recorded);
     const std::string why = td::replay_shortfall(bad.transport(), bad.unparsed_bytes());
     CHECK_THAT(why, Catch::Contains("replay out of step"));
   }
@@ -462,7 +468,7 @@ TEST_CASE("Sessions: recorded through the device, replayed byte-exact, checked",
     truncated.start();
     int frames = 0;
     while (truncated.read_frame()) ++frames;
-    CHECK(frames < 5);
+    CHECK(frames < recorded);
     CHECK(truncated.unparsed_bytes() > 0);
     CHECK_THAT(td::replay_shortfall(truncated.transport(), truncated.unparsed_bytes()),
                Catch::Contains("the last packet is cut off"));
