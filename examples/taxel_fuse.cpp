@@ -45,10 +45,10 @@ taxel-record --poses writes it, columns time_ms,matrix,...) or else the controll
 matrix poses.
 
 CONTACTS.csv has a header naming its columns
-(time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure; x, y, z required; see
-include/taxel/io/contacts_csv.hpp); CLOUD.ply gets the fused points with their normals (surfel)
-and the properties "observations", the covariance "cov_xx", "cov_xy", "cov_xz", "cov_yy",
-"cov_yz", "cov_zz" [m^2] and "last_time". Units: metres and seconds.
+(time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure, normal_sigma; x, y, z
+required; see include/taxel/io/contacts_csv.hpp); CLOUD.ply gets the fused points with their
+normals (surfel) and the properties "observations", the covariance "cov_xx", "cov_xy",
+"cov_xz", "cov_yy", "cov_yz", "cov_zz" [m^2] and "last_time". Units: metres and seconds.
 
 options:
   --policy surfel|kalman|average|raw    fusion policy (default surfel: a Kalman point that

@@ -171,6 +171,14 @@ the C++ loop with no conversion.)doc")
             return out;
           },
           "(N,) times [s]")
+      .def_property_readonly(
+          "normal_sigmas",
+          [](const ContactList& cs) {
+            py::array_t<double> out(static_cast<py::ssize_t>(cs.size()));
+            for (std::size_t i = 0; i < cs.size(); ++i) out.mutable_data()[i] = cs[i].normal_sigma;
+            return out;
+          },
+          "(N,) angular standard deviations of the normals [rad]; 0 where not stated")
       .def("__repr__",
            [](const ContactList& cs) { return "Contacts(" + std::to_string(cs.size()) + ")"; });
 }

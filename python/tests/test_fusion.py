@@ -190,6 +190,8 @@ def test_readings_to_contacts_equal_the_simulators():
         np.testing.assert_array_equal(made.positions, want.positions)
         np.testing.assert_array_equal(made.covariances, want.covariances)
         np.testing.assert_array_equal(made.times, want.times)
+        np.testing.assert_array_equal(made.normal_sigmas, want.normal_sigmas)
+        assert (made.normal_sigmas > 0).all()
         a = fusion.ContactCloud()
         a.insert_readings(ex.readings, ex.poses(), times=ex.times, options=opts)
         b = fusion.ContactCloud()

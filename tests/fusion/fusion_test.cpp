@@ -412,6 +412,11 @@ TEST_CASE("ContactCloud rejects invalid contacts and stays unchanged", "[fusion]
   c = contact_at<double>({0, 0, 0}, R);
   c.pressure = -inf;
   bad.push_back({c, taxel::ContactDefect::non_finite_pressure});
+  for (const double sigma : {-0.1, nan, inf}) {
+    c = contact_at<double>({0, 0, 0}, R);
+    c.normal_sigma = sigma;
+    bad.push_back({c, taxel::ContactDefect::bad_normal_sigma});
+  }
   // Beyond the voxel hash's exact range (about 6400 km for this radius), where every point
   // would share a clamped border cell and inserts would turn quadratic.
   bad.push_back({contact_at<double>({0, 1e7, 0}, R), taxel::ContactDefect::out_of_range});
@@ -644,6 +649,39 @@ TEST_CASE("Surfel fits the curvature of a cylinder patch", "[fusion]") {
   CHECK(h[0] + h[2] == Approx(1 / R).epsilon(0.03));
   CHECK(std::abs(h[0] * h[2] - h[1] * h[1]) < 0.05 / (R * R));
   CHECK(std::abs(surfel.mean(s).head<2>().norm() - R) < 5e-6);
+}
+
+TEST_CASE("Surfel weights a guessed normal's slope down by the sigma it states", "[fusion]") {
+  // The cylinder patch above, plus contacts on one side of it whose normals are wrong by 0.9
+  // rad in one direction (a pad's normal where no neighbour measured the slope). Stated as
+  // guesses (normal_sigma 1 rad) they barely move the fit; unstated, they bend it.
+  const double R = 0.03;
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-3e-3, 3e-3);
+  const auto make = [&](bool guessed, double sigma) {
+    const double phi = (guessed ? std::abs(u(rng)) : u(rng)) / R, z = u(rng);
+    const taxel::Vec3d n(std::cos(phi), std::sin(phi), 0);
+    auto c =
+        contact_at<double>(R * n + taxel::Vec3d(0, 0, z), taxel::pad_covariance(n, 3e-4, 1e-3));
+    c.normal = guessed ? taxel::Vec3d(std::cos(phi + 0.9), std::sin(phi + 0.9), 0) : n;
+    c.normal_sigma = guessed ? sigma : 0.02;
+    return c;
+  };
+  const tf::Surfel<double> surfel;
+  const auto fit = [&](double sigma) {
+    rng.seed(12);
+    auto s = surfel.init(make(false, sigma));
+    for (std::uint32_t i = 1; i < 500; ++i) surfel.fuse(s, make(i % 5 == 0, sigma), i);
+    double h[3];
+    surfel.fit_curvature(s, h);
+    return std::pair{h[0] + h[2], std::abs(surfel.mean(s).head<2>().norm() - R)};
+  };
+  const auto [trace_stated, off_stated] = fit(1.0);
+  const auto [trace_unstated, off_unstated] = fit(0.0);
+  CAPTURE(trace_stated * R, trace_unstated * R, off_stated, off_unstated);
+  CHECK(trace_stated == Approx(1 / R).epsilon(0.05));
+  CHECK(std::abs(trace_unstated - 1 / R) > 0.5 / R);
+  CHECK(off_stated < 1e-5);
 }
 
 TEST_CASE("a valid contact whose Surfel weight overflows is refused, not added as NaN",

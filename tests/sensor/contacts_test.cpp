@@ -396,6 +396,39 @@ TEST_CASE("readings to contacts: per pad, the quadric's point above the centroid
   CHECK(taxel::check_contact(out[0]) == taxel::ContactDefect::ok);
 }
 
+TEST_CASE("readings to contacts: each contact states its normal's uncertainty", "[sensor]") {
+  const tsn::SensorModel m;  // default noise
+  tsn::ContactExtractor ex(m);
+  std::vector<taxel::Contact<double>> out;
+  const double fb = tsn::ContactOptions{}.fallback_normal_sigma;
+  SECTION("a lone tactel: the pad's normal, both slopes unmeasured") {
+    tsn::PadMatrix counts = tsn::PadMatrix::Zero(m.geometry.rows, m.geometry.cols);
+    counts(5, 3) = 1000;
+    REQUIRE(ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out) == 1);
+    CHECK(*out[0].normal == Vec3d(0, 0, -1));
+    CHECK(out[0].normal_sigma == Approx(std::sqrt(2.0) * fb).epsilon(1e-12));
+  }
+  SECTION("a row of tactels: the slope across it unmeasured") {
+    tsn::PadMatrix counts = tsn::PadMatrix::Zero(m.geometry.rows, m.geometry.cols);
+    for (int c = 0; c < m.geometry.cols; ++c) counts(5, c) = 1000;
+    ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out);
+    REQUIRE(out.size() == std::size_t(m.geometry.cols));
+    for (const auto& c : out) {
+      CHECK(c.normal_sigma > fb);
+      CHECK(c.normal_sigma < std::sqrt(2.0) * fb);
+    }
+  }
+  SECTION("a pressed plane: the fit's own slope variances, well below the fallback") {
+    const auto counts = readings(m, [](double x, double) { return 1e-3 + 0.2 * x; });
+    ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out);
+    REQUIRE(out.size() > 20);
+    for (const auto& c : out) {
+      CHECK(c.normal_sigma > 0.0);
+      CHECK(c.normal_sigma < fb / 3);  // 0.04 at the pad's corners, where the quadric levers
+    }
+  }
+}
+
 TEST_CASE("readings to contacts: per pad, a light touch gives its tactels one by one", "[sensor]") {
   const tsn::SensorModel m = noiseless();
   tsn::ContactExtractor pad(m, {.mode = tsn::ContactMode::per_pad});

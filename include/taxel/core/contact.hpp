@@ -15,7 +15,7 @@
 namespace taxel {
 
 /// One 3-D contact point as measured by a tactile sensor, in the world frame.
-/// Trivially copyable; 88 bytes for double, 48 for float.
+/// Trivially copyable; 96 bytes for double, 56 for float.
 template <Scalar S>
 struct Contact {
   Vec3<S> position = Vec3<S>::Zero();  ///< contact location [m], world frame
@@ -25,6 +25,10 @@ struct Contact {
   std::optional<Vec3<S>> normal;  ///< unit outward pad normal [-], world frame, if known
   S pressure = S(0);              ///< contact pressure [Pa], or the sensor's raw units
   double time = 0.0;              ///< acquisition time [s]
+  /// Angular standard deviation of `normal` [rad], >= 0; 0 (the default) when not stated, so
+  /// that a fusion policy uses its own (`fusion::Surfel::Config::normal_sigma`). A normal the
+  /// sensor could not measure (a lone tactel: the pad's own normal) states a large one.
+  S normal_sigma = S(0);
 };
 
 /// Standard deviation [m] of a uniform quantisation over one tactel of the given pitch [m]:
@@ -77,6 +81,7 @@ enum class ContactDefect {
   non_finite_time,        ///< time is NaN or Inf
   non_finite_pressure,    ///< pressure is NaN or Inf
   out_of_range,           ///< position beyond what the cloud's index separates exactly
+  bad_normal_sigma,       ///< normal_sigma is negative, NaN or Inf
 };
 
 /// Short description of a contact defect.
@@ -102,6 +107,8 @@ constexpr std::string_view to_string(ContactDefect d) noexcept {
       return "pressure is not finite";
     case ContactDefect::out_of_range:
       return "position is beyond the index's range";
+    case ContactDefect::bad_normal_sigma:
+      return "normal_sigma is not finite and >= 0";
   }
   return "unknown";
 }
@@ -144,6 +151,9 @@ ContactDefect check_contact(const Contact<S>& c) noexcept {
     const S n2 = c.normal->squaredNorm();
     if (!(n2 >= S(0.999 * 0.999) && n2 <= S(1.001 * 1.001))) return ContactDefect::bad_normal;
   }
+  if (!(c.normal_sigma >= S(0)) || !std::isfinite(c.normal_sigma)) {
+    return ContactDefect::bad_normal_sigma;
+  }
   if (!std::isfinite(c.time)) return ContactDefect::non_finite_time;
   if (!std::isfinite(c.pressure)) return ContactDefect::non_finite_pressure;
   return ContactDefect::ok;
@@ -158,6 +168,7 @@ Contact<T> contact_cast(const Contact<S>& c) {
   if (c.normal) out.normal = c.normal->template cast<T>();
   out.pressure = static_cast<T>(c.pressure);
   out.time = c.time;
+  out.normal_sigma = static_cast<T>(c.normal_sigma);
   return out;
 }
 

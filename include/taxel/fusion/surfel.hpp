@@ -34,7 +34,10 @@ namespace taxel::fusion {
 ///    normal part, which is H u + const on a quadric) are accumulated, 13 sums in all;
 ///  - the curvature H is the symmetric part of the least-squares fit of s on u, with a ridge
 ///    prior H ~ N(0, curvature_prior^2) against normal noise `normal_sigma`, so that few or
-///    collinear contacts give H near 0;
+///    collinear contacts give H near 0; a contact whose normal states a larger uncertainty
+///    (`Contact::normal_sigma`, sigma_c > normal_sigma: a normal the sensor guessed rather than
+///    measured) enters the fit with its slope weighted down by (normal_sigma / sigma_c)^2, and
+///    its position in full;
 ///  - the mean is the quadric's point above the weighted centroid of the offsets: the
 ///    weighted mean height plus the sag tr(H C_uu) / 2 (C_uu the weighted covariance of the
 ///    offsets), the sag bounded by half the offsets' spread so that a noisy fit cannot throw
@@ -44,7 +47,7 @@ namespace taxel::fusion {
 /// (all equal) the rotation is the identity and H = 0: the result is exactly `Kalman`'s.
 /// The offsets are measured positions: their own noise is not removed from M (the contacts
 /// a point gathers are those whose noisy positions fall near it, a Berkson error model, so
-/// an errors-in-variables correction would overcorrect). State: 264 bytes (double).
+/// an errors-in-variables correction would overcorrect). State: 312 bytes (double).
 /// No allocation.
 template <Scalar S>
 struct Surfel {
@@ -67,9 +70,13 @@ struct Surfel {
     S count;             ///< contacts in the sums
     S weight;            ///< sum of their weights w (information along the normal) [1/m^2]
     S sz;                ///< w-weighted sum of the heights z along n0 [m]
-    S su[2], ss[2];      ///< w-weighted sums of u [m] and s [-]
+    S su[2];             ///< w-weighted sum of u [m]
     S suu[3];            ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
-    S ssu[4];            ///< w-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
+    // The curvature fit's sums, weighted by v = w k (k <= 1 the slope's share, see share()).
+    S vweight;       ///< sum of v [1/m^2]
+    S vu[2], ss[2];  ///< v-weighted sums of u [m] and s [-]
+    S vuu[3];        ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
+    S ssu[4];        ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
   };
   static constexpr bool kMerges = true;
 
@@ -144,7 +151,7 @@ struct Surfel {
     const S w = S(1) / nm.dot(turned.covariance * nm);
     s.normal_sum += nc;
     s.count += S(1);
-    add_sums(s, w, ux, uy, s.n0.dot(d), sx, sy);
+    add_sums(s, w, share(c), ux, uy, s.n0.dot(d), sx, sy);
     return true;
   }
 
@@ -184,12 +191,14 @@ struct Surfel {
   void fit_curvature(const State& s, S h[3]) const noexcept {
     h[0] = h[1] = h[2] = S(0);
     if (s.count < S(3)) return;
-    const S inv = S(1) / s.weight;
-    const S ux = s.su[0] * inv, uy = s.su[1] * inv, sx = s.ss[0] * inv, sy = s.ss[1] * inv;
+    const S inv = S(1) / s.vweight;
+    const S ux = s.vu[0] * inv, uy = s.vu[1] * inv, sx = s.ss[0] * inv, sy = s.ss[1] * inv;
+    // The ridge against the fit's total slope information: count / normal_sigma^2 when every
+    // slope has the default noise, less as stated slopes are noisier (weight / vweight).
     const S lambda = config_.normal_sigma * config_.normal_sigma /
-                     (config_.curvature_prior * config_.curvature_prior) / s.count;
-    const S a = s.suu[0] * inv - ux * ux + lambda, b = s.suu[1] * inv - ux * uy;
-    const S d = s.suu[2] * inv - uy * uy + lambda;
+                     (config_.curvature_prior * config_.curvature_prior) / s.count * s.weight * inv;
+    const S a = s.vuu[0] * inv - ux * ux + lambda, b = s.vuu[1] * inv - ux * uy;
+    const S d = s.vuu[2] * inv - uy * uy + lambda;
     const S det = a * d - b * b;
     if (!(det > S(0))) return;
     // C_su (C_uu + lambda I)^-1, rows s_x, s_y; its symmetric part.
@@ -202,28 +211,42 @@ struct Surfel {
   }
 
  private:
-  static void start_frame(State& s, const Contact<S>& c) {
+  void start_frame(State& s, const Contact<S>& c) const {
     s.origin = c.position;
     s.n0 = *c.normal;
     s.t1 = s.n0.unitOrthogonal();
     s.normal_sum = s.n0;
     s.count = S(1);
-    add_sums(s, S(1) / s.n0.dot(c.covariance * s.n0), S(0), S(0), S(0), S(0), S(0));
+    add_sums(s, S(1) / s.n0.dot(c.covariance * s.n0), share(c), S(0), S(0), S(0), S(0), S(0));
   }
-  static void add_sums(State& s, S w, S ux, S uy, S z, S sx, S sy) {
+  // The weight of a contact's slope in the curvature fit, relative to its height's: 1 for a
+  // normal as good as normal_sigma (or one that states no sigma_c), (normal_sigma / sigma_c)^2
+  // for a worse one.
+  S share(const Contact<S>& c) const noexcept {
+    const S r = config_.normal_sigma / c.normal_sigma;  // +inf for sigma_c = 0
+    return std::min(S(1), r * r);
+  }
+  static void add_sums(State& s, S w, S k, S ux, S uy, S z, S sx, S sy) {
     s.weight += w;
     s.sz += w * z;
     s.su[0] += w * ux;
     s.su[1] += w * uy;
-    s.ss[0] += w * sx;
-    s.ss[1] += w * sy;
     s.suu[0] += w * ux * ux;
     s.suu[1] += w * ux * uy;
     s.suu[2] += w * uy * uy;
-    s.ssu[0] += w * sx * ux;
-    s.ssu[1] += w * sx * uy;
-    s.ssu[2] += w * sy * ux;
-    s.ssu[3] += w * sy * uy;
+    const S v = w * k;
+    s.vweight += v;
+    s.vu[0] += v * ux;
+    s.vu[1] += v * uy;
+    s.ss[0] += v * sx;
+    s.ss[1] += v * sy;
+    s.vuu[0] += v * ux * ux;
+    s.vuu[1] += v * ux * uy;
+    s.vuu[2] += v * uy * uy;
+    s.ssu[0] += v * sx * ux;
+    s.ssu[1] += v * sx * uy;
+    s.ssu[2] += v * sy * ux;
+    s.ssu[3] += v * sy * uy;
   }
 
   Config config_{};

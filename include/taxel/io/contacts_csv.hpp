@@ -9,6 +9,8 @@
 //                                                                      none; empty cells: no
 //                                                                      normal for that contact
 //   pressure                      pressure [Pa] or raw sensor units    optional (default 0)
+//   normal_sigma                  angular standard deviation of the    optional (default 0: not
+//                                 normal [rad] (Contact::normal_sigma)  stated); empty cell: 0
 // Lines starting with '#' and blank lines are skipped; CRLF is accepted. By default the reader
 // is strict: unknown or repeated columns, missing values, malformed numbers and non-finite
 // positions are refused with the line and column. With ContactsCsvOptions::strict = false,
@@ -34,8 +36,9 @@
 namespace taxel::io {
 
 /// Column names in the order encode_contacts_csv writes them.
-inline constexpr std::array<std::string_view, 14> kContactColumns{
-    "time", "x", "y", "z", "cxx", "cxy", "cxz", "cyy", "cyz", "czz", "nx", "ny", "nz", "pressure"};
+inline constexpr std::array<std::string_view, 15> kContactColumns{
+    "time", "x",   "y",  "z",  "cxx", "cxy",      "cxz",         "cyy",
+    "cyz",  "czz", "nx", "ny", "nz",  "pressure", "normal_sigma"};
 
 /// Largest number of contacts the reader accepts (2^26).
 inline constexpr std::size_t kMaxContacts = std::size_t{1} << 26;
@@ -99,7 +102,8 @@ inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
         if (k == kContactColumns.size()) {
           fail(c,
                "unknown column '" + std::string(cells[c].substr(0, 24)) +
-                   "' (known: time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure)");
+                   "' (known: time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure, "
+                   "normal_sigma)");
         }
         if (where[k] >= 0) fail(c, "column '" + std::string(cells[c]) + "' appears twice");
         where[k] = static_cast<int>(c);
@@ -162,6 +166,7 @@ inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
         }
       }
       if (where[13] >= 0) ct.pressure = *value(13, false);
+      if (where[14] >= 0) ct.normal_sigma = value(14, true).value_or(0.0);
       out.push_back(ct);
     } catch (const IoError& e) {
       if (options.strict) throw;
@@ -210,6 +215,8 @@ inline std::string encode_contacts_csv(const std::vector<Contact<double>>& conta
     }
     out.push_back(',');
     put(c.pressure);
+    out.push_back(',');
+    put(c.normal_sigma);
     out.push_back('\n');
   }
   return out;
