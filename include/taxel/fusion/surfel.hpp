@@ -223,8 +223,9 @@ struct Surfel {
   // normal as good as normal_sigma (or one that states no sigma_c), (normal_sigma / sigma_c)^2
   // for a worse one.
   S share(const Contact<S>& c) const noexcept {
-    const S r = config_.normal_sigma / c.normal_sigma;  // +inf for sigma_c = 0
-    return std::min(S(1), r * r);
+    if (!(c.normal_sigma > config_.normal_sigma)) return S(1);
+    const S r = config_.normal_sigma / c.normal_sigma;
+    return r * r;
   }
   static void add_sums(State& s, S w, S k, S ux, S uy, S z, S sx, S sy) {
     s.weight += w;
