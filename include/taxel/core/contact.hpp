@@ -15,7 +15,7 @@
 namespace taxel {
 
 /// One 3-D contact point as measured by a tactile sensor, in the world frame.
-/// Trivially copyable; 96 bytes for double, 56 for float.
+/// Trivially copyable; 152 bytes for double, 88 for float.
 template <Scalar S>
 struct Contact {
   Vec3<S> position = Vec3<S>::Zero();  ///< contact location [m], world frame

@@ -31,7 +31,7 @@ namespace taxel::fusion {
 ///    taking the contact normal to it), so all tight planes are parallel and the Kalman mean
 ///    is an information-weighted average in that frame, whose only bias is the sag;
 ///  - its sideways offset u (in the frame) and its normal's slope s (sideways part over
-///    normal part, which is H u + const on a quadric) are accumulated, 13 sums in all;
+///    normal part, which is H u + const on a quadric) are accumulated, 19 sums in all;
 ///  - the curvature H is the symmetric part of the least-squares fit of s on u, with a ridge
 ///    prior H ~ N(0, curvature_prior^2) against normal noise `normal_sigma`, so that few or
 ///    collinear contacts give H near 0; a contact whose normal states a larger uncertainty
@@ -47,7 +47,7 @@ namespace taxel::fusion {
 /// (all equal) the rotation is the identity and H = 0: the result is exactly `Kalman`'s.
 /// The offsets are measured positions: their own noise is not removed from M (the contacts
 /// a point gathers are those whose noisy positions fall near it, a Berkson error model, so
-/// an errors-in-variables correction would overcorrect). State: 312 bytes (double).
+/// an errors-in-variables correction would overcorrect). State: 352 bytes (double).
 /// No allocation.
 template <Scalar S>
 struct Surfel {
