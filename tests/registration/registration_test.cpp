@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: MIT
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -8,6 +9,7 @@
 #include <taxel/io/ply.hpp>
 #include <taxel/registration.hpp>
 #include <taxel/sim/sampling.hpp>
+#include <utility>
 #include <vector>
 
 #include "../support/allocation_counter.hpp"
@@ -75,6 +77,62 @@ IcpConfig tight() {
 }
 
 }  // namespace
+
+TEST_CASE("symmetric_eigen: eigenpairs of symmetric 6x6 matrices against closed forms and Eigen",
+          "[registration][icp]") {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  // Known spectra in a random orthonormal basis: distinct, repeated, zero (a plane's three
+  // free directions), spanning 12 decades, and negative.
+  const std::vector<std::array<double, 6>> spectra = {{1, 2, 3, 4, 5, 6},
+                                                      {0, 0, 0, 1, 1, 2},
+                                                      {1e-12, 1e-9, 1e-6, 1e-3, 1, 1},
+                                                      {-3, -1, 0, 2, 2, 7},
+                                                      {5, 5, 5, 5, 5, 5}};
+  for (const auto& spectrum : spectra) {
+    for (int trial = 0; trial < 20; ++trial) {
+      Mat6d m;
+      for (int i = 0; i < 36; ++i) m(i) = g(rng);
+      const Mat6d q = Eigen::HouseholderQR<Mat6d>(m).householderQ();
+      Vec6d want;
+      for (int i = 0; i < 6; ++i) want(i) = spectrum[static_cast<std::size_t>(i)];
+      Mat6d a = q * want.asDiagonal() * q.transpose();
+      a = (0.5 * (a + a.transpose())).eval();
+      Vec6d values;
+      Mat6d vectors;
+      registration::detail::symmetric_eigen(a, values, vectors);
+      const double scale = a.norm();
+      for (int i = 0; i < 6; ++i) CHECK(values(i) == Approx(want(i)).margin(1e-13 * scale));
+      CHECK((vectors.transpose() * vectors - Mat6d::Identity()).norm() < 1e-13);
+      CHECK((a * vectors - vectors * values.asDiagonal()).norm() < 1e-13 * scale);
+      const Eigen::SelfAdjointEigenSolver<Mat6d> oracle(a);
+      CHECK((values - oracle.eigenvalues()).norm() < 1e-13 * scale);
+    }
+  }
+  SECTION("a diagonal matrix needs no rotation, and is sorted") {
+    const Vec6d d = (Vec6d() << 3, -1, 2, 0, 5, 4).finished();
+    Vec6d values;
+    Mat6d vectors;
+    const Mat6d a = d.asDiagonal();
+    registration::detail::symmetric_eigen(a, values, vectors);
+    CHECK(values == (Vec6d() << -1, 0, 2, 3, 4, 5).finished());
+    CHECK((a * vectors - vectors * values.asDiagonal()).norm() == 0.0);  // a permutation
+    CHECK((vectors.transpose() * vectors - Mat6d::Identity()).norm() == 0.0);
+  }
+  SECTION("a NaN or infinite entry gives NaN eigenvalues") {
+    for (const double bad :
+         {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+      for (const auto& [i, j] : {std::pair{1, 2}, std::pair{4, 4}}) {
+        Mat6d a = Mat6d::Identity();
+        a(i, j) = a(j, i) = bad;
+        Vec6d values;
+        Mat6d vectors;
+        registration::detail::symmetric_eigen(a, values, vectors);
+        CHECK(values.array().isNaN().all());
+      }
+    }
+  }
+}
 
 TEST_CASE("UniformGrid answers exactly as brute force", "[registration][index]") {
   std::mt19937_64 rng(42);
