@@ -60,6 +60,15 @@ ArrayD covariances_array(const ContactList& cs) {
   return out;
 }
 
+// One scalar field of every contact as an (N,) array.
+template <double Contact<double>::*Field>
+py::array_t<double> contact_column(const ContactList& cs) {
+  py::array_t<double> out(static_cast<py::ssize_t>(cs.size()));
+  double* p = out.mutable_data();
+  for (const auto& c : cs) *p++ = c.*Field;
+  return out;
+}
+
 }  // namespace
 
 void bind_core(py::module_& m) {
@@ -155,29 +164,11 @@ the C++ loop with no conversion.)doc")
             return out;
           },
           "(N, 3) unit normals; NaN rows where a contact has none")
+      .def_property_readonly("pressures", &contact_column<&Contact<double>::pressure>,
+                             "(N,) pressures")
+      .def_property_readonly("times", &contact_column<&Contact<double>::time>, "(N,) times [s]")
       .def_property_readonly(
-          "pressures",
-          [](const ContactList& cs) {
-            py::array_t<double> out(static_cast<py::ssize_t>(cs.size()));
-            for (std::size_t i = 0; i < cs.size(); ++i) out.mutable_data()[i] = cs[i].pressure;
-            return out;
-          },
-          "(N,) pressures")
-      .def_property_readonly(
-          "times",
-          [](const ContactList& cs) {
-            py::array_t<double> out(static_cast<py::ssize_t>(cs.size()));
-            for (std::size_t i = 0; i < cs.size(); ++i) out.mutable_data()[i] = cs[i].time;
-            return out;
-          },
-          "(N,) times [s]")
-      .def_property_readonly(
-          "normal_sigmas",
-          [](const ContactList& cs) {
-            py::array_t<double> out(static_cast<py::ssize_t>(cs.size()));
-            for (std::size_t i = 0; i < cs.size(); ++i) out.mutable_data()[i] = cs[i].normal_sigma;
-            return out;
-          },
+          "normal_sigmas", &contact_column<&Contact<double>::normal_sigma>,
           "(N,) angular standard deviations of the normals [rad]; 0 where not stated")
       .def("__repr__",
            [](const ContactList& cs) { return "Contacts(" + std::to_string(cs.size()) + ")"; });
