@@ -91,8 +91,16 @@ def test_array_and_contacts_inputs_agree(rng):
     a = fusion.ContactCloud()
     b = fusion.ContactCloud()
     a.insert(pos, cov, times=times)
-    b.insert(taxel.Contacts(pos, cov, times=times))
+    contacts = taxel.Contacts(pos, cov, pressures=np.linspace(1.0, 2.0, len(pos)), times=times)
+    b.insert(contacts)
     np.testing.assert_array_equal(a.means, b.means)
+    # The columns read back as they went in; no contact states a normal or its sigma.
+    np.testing.assert_array_equal(contacts.positions, pos)
+    np.testing.assert_array_equal(contacts.covariances, cov)
+    np.testing.assert_array_equal(contacts.pressures, np.linspace(1.0, 2.0, len(pos)))
+    np.testing.assert_array_equal(contacts.times, times)
+    assert np.isnan(contacts.normals).all()
+    np.testing.assert_array_equal(contacts.normal_sigmas, np.zeros(len(pos)))
     np.testing.assert_array_equal(a.last_times, b.last_times)
     # Non-contiguous and non-float64 inputs are converted, with the same result.
     c = fusion.ContactCloud()
