@@ -305,8 +305,8 @@ struct PointToPlane {
       // Newton step within the constrained subspace N (the eigenvectors past the free ones):
       // x = -N (N'hN)^-1 N'g. In the eigenbasis that is the 6x6 system whose free rows and
       // columns are the identity's and whose free right-hand entries are zero, so the
-      // fixed-size solver of the full step serves here too (dynamic-size products and a
-      // second LDLT cost about 20 s of compile time per translation unit).
+      // fixed-size solver of the full step serves here too (the dynamic-size products and
+      // LDLT this took before were much of the compile time of every caller).
       Mat6d reduced = basis.transpose() * h * basis;
       Vec6d rhs = basis.transpose() * g;
       for (int k = 0; k < free; ++k) {
