@@ -100,10 +100,13 @@ inline std::vector<Contact<double>> parse_contacts_csv(std::string_view text,
           continue;
         }
         if (k == kContactColumns.size()) {
-          fail(c,
-               "unknown column '" + std::string(cells[c].substr(0, 24)) +
-                   "' (known: time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure, "
-                   "normal_sigma)");
+          std::string known;
+          for (const std::string_view name : kContactColumns) {
+            known += known.empty() ? "" : ", ";
+            known += name;
+          }
+          fail(c, "unknown column '" + std::string(cells[c].substr(0, 24)) + "' (known: " + known +
+                      ")");
         }
         if (where[k] >= 0) fail(c, "column '" + std::string(cells[c]) + "' appears twice");
         where[k] = static_cast<int>(c);
