@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -105,6 +107,42 @@ inline bool parse_length(std::string_view text, double& metres) {
 }
 
 /// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).
+/// True when the paths `a` and `b` name the same file: an existing one (hard or symbolic links
+/// included), or the same path once made absolute and resolved ("./x" and "x"). Standard
+/// streams ("-") and empty names are no files.
+inline bool same_file(std::string_view a, std::string_view b) {
+  if (a.empty() || b.empty() || a == "-" || b == "-") return false;
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path pa(a), pb(b);
+  if (fs::equivalent(pa, pb, ec)) return true;
+  const fs::path ca = fs::weakly_canonical(pa, ec);
+  if (ec) return false;
+  const fs::path cb = fs::weakly_canonical(pb, ec);
+  return !ec && ca == cb;
+}
+
+/// Why the output file `output` cannot be written, or "" when it can: it is one of `inputs`
+/// or of `other_outputs` (same_file). A tool writes its outputs after reading its inputs, so it
+/// would replace an input with its result, or one output with another.
+template <class Inputs = std::initializer_list<std::string_view>>
+std::string output_conflict(std::string_view output, const Inputs& inputs,
+                            std::initializer_list<std::string_view> other_outputs = {}) {
+  for (const auto& in : inputs) {
+    if (same_file(output, in)) {
+      return "the output '" + std::string(output) + "' is the input '" + std::string(in) +
+             "': writing it would replace the input; name another output";
+    }
+  }
+  for (const std::string_view other : other_outputs) {
+    if (same_file(output, other)) {
+      return "the outputs '" + std::string(output) + "' and '" + std::string(other) +
+             "' are the same file; name two different files";
+    }
+  }
+  return {};
+}
+
 class Args {
  public:
   Args(const char* tool, int argc, char** argv) : tool_(tool), argc_(argc), argv_(argv) {}
@@ -172,6 +210,13 @@ class Args {
     std::string list(allowed);
     for (char& c : list) c = c == '|' ? ',' : c;
     fail(std::string(current_) + " must be one of " + list + ", not '" + std::string(v) + "'");
+  }
+
+  /// Fails (exit 2) with output_conflict's message when there is one.
+  void check_output(std::string_view output, std::initializer_list<std::string_view> inputs,
+                    std::initializer_list<std::string_view> other_outputs = {}) const {
+    const std::string why = output_conflict(output, inputs, other_outputs);
+    if (!why.empty()) fail(why);
   }
 
   /// Prints "<tool>: <why>" and exits with `code`.

@@ -127,6 +127,9 @@ Options parse(int argc, char** argv) {
   }
   if (o.libsvm && o.labels.empty()) die("--format libsvm needs --labels FILE");
   if (!o.libsvm && !o.labels.empty()) die("--labels is only used with --format libsvm");
+  std::vector<std::string> read = o.inputs;
+  read.push_back(o.labels);
+  if (const std::string why = taxel_cli::output_conflict(o.output, read); !why.empty()) die(why);
   return o;
 }
 

@@ -363,6 +363,7 @@ int main(int argc, char** argv) {
   if ((o.files[0] == "-") + (o.readings == "-") + (o.poses == "-") > 1) {
     args.fail("only one input can be standard input (-)");
   }
+  args.check_output(o.files[1], {o.files[0], o.readings, o.poses, o.session});
   std::vector<taxel::Contact<double>> contacts;
   taxel::sensor::ContactOptions copt;
   copt.mode =

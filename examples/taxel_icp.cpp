@@ -174,6 +174,7 @@ int main(int argc, char** argv) {
   taxel_cli::print_version_if_asked("taxel-icp", argc, argv);
   taxel_cli::Args args("taxel-icp", argc, argv);
   const Options opt = parse(args);
+  args.check_output(opt.output, {opt.inputs[0], opt.inputs[1]});
   taxel::io::PlyData source, target;
   const std::string src_name = taxel_cli::input_name(opt.inputs[0]);
   const std::string tgt_name = taxel_cli::input_name(opt.inputs[1]);

@@ -104,6 +104,10 @@ int main(int argc, char** argv) {
       return 2;
     }
     if (files[1] == "-") fail("model_file must be a file, not standard input", 2);
+    if (const std::string why = taxel_cli::output_conflict(files[2], {files[0], files[1]});
+        !why.empty()) {
+      fail(why, 2);
+    }
     const tl::LinearSvm model = tl::LinearSvm::load(taxel::io::read_file(files[1]), files[1]);
     tl::Dataset test = taxel::io::parse_libsvm(taxel_cli::read_input(files[0]),
                                                taxel_cli::input_name(files[0]), read_opt);

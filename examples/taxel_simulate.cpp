@@ -322,6 +322,13 @@ int main(int argc, char** argv) {
   if (o.shape == "mesh" && o.mesh.empty()) args.fail("--shape mesh needs --mesh FILE.ply");
   if (o.shape != "mesh" && !o.mesh.empty()) args.fail("--mesh is only used with --shape mesh");
   if (o.shape != "mesh" && o.scale != 1.0) args.fail("--scale is only used with --shape mesh");
+  {
+    const std::string truth = o.files.size() > 1 ? o.files[1] : std::string();
+    args.check_output(o.files[0], {o.mesh}, {truth, o.readings, o.poses});
+    args.check_output(truth, {o.mesh}, {o.readings, o.poses});
+    args.check_output(o.readings, {o.mesh}, {o.poses});
+    args.check_output(o.poses, {o.mesh});
+  }
   const auto dims = [&](std::size_t n, std::vector<double> fallback) {
     if (o.size.empty()) return fallback;
     if (o.size.size() != n) {

@@ -179,6 +179,9 @@ int main(int argc, char** argv) {
       usage_error(e.what());
     }
     const tl::LinearSvm& prototype = *checked;
+    if (const std::string why = taxel_cli::output_conflict(model_file, {data_file}); !why.empty()) {
+      usage_error(why);
+    }
     const tl::Dataset data = taxel::io::parse_libsvm(taxel_cli::read_input(data_file),
                                                      taxel_cli::input_name(data_file), read_opt);
     if (data_file == "-" && model_file.empty() && !search_c && folds == 0) {

@@ -190,6 +190,7 @@ int main(int argc, char** argv) {
                       int(!o.emulate.empty());
   if (sources != 1) args.fail("give exactly one of --serial, --usb, --usb-bus, --emulate");
   if (!o.poses.empty() && o.emulate.empty()) args.fail("--poses needs --emulate");
+  args.check_output(o.out, {o.serial}, {o.poses});
   const auto pair = [&](const std::string& text, int base, const char* what) {
     const auto p = cli::parse_pair(text, base);
     if (!p) args.fail(std::string(what) + ": '" + text + "' is not of the form A:B");

@@ -3,7 +3,9 @@
 # - standard output on /dev/full: exit 1 with "cannot write standard output";
 # - a file output on a "full disk" (the file size limit at 0, as `ulimit -f 0`, with SIGXFSZ
 #   ignored, so every write to a regular file fails with EFBIG): exit 1 naming the file, the
-#   previous file unchanged, no temporary file left beside it.
+#   previous file unchanged, no temporary file left beside it;
+# - an output that is one of the run's inputs, or another of its outputs: exit 2, nothing
+#   written, the input unchanged.
 # Run with -DSIMULATE= -DFUSE= -DICP= -DRECOGNIZE= -DDESCRIBE= -DTRAIN= -DPREDICT= -DDEMO=
 # -DWORK_DIR=.
 include(${CMAKE_CURRENT_LIST_DIR}/cli_common.cmake)
@@ -107,3 +109,46 @@ file(MAKE_DIRECTORY "${WORK_DIR}/demo")
 # The demo writes many files; the first that fails ends it (index.html comes last).
 set(NAMED "demo/")
 expect_file_loss(demo/index.html "${DEMO}" --quick demo)
+
+# An output that is an input (by name, another relative path, or a link), or another output:
+# refused before anything is read or written, the input as it was.
+function(expect_refused tool pattern)
+  file(GLOB before RELATIVE "${WORK_DIR}" "${WORK_DIR}/*")
+  foreach(f IN LISTS before)
+    if(NOT IS_DIRECTORY "${WORK_DIR}/${f}")
+      file(SHA256 "${WORK_DIR}/${f}" sum_${f})
+    endif()
+  endforeach()
+  run_tool("${tool}" 2 ${ARGN})
+  expect("${err}" "${pattern}")
+  expect_one_line("${err}")
+  file(GLOB after RELATIVE "${WORK_DIR}" "${WORK_DIR}/*")
+  if(NOT after STREQUAL before)
+    message(FATAL_ERROR "${tool} ${ARGN}: files appeared or vanished:\n${before}\n${after}")
+  endif()
+  foreach(f IN LISTS before)
+    if(NOT IS_DIRECTORY "${WORK_DIR}/${f}")
+      file(SHA256 "${WORK_DIR}/${f}" now)
+      if(NOT now STREQUAL sum_${f})
+        message(FATAL_ERROR "${tool} ${ARGN}: ${f} changed")
+      endif()
+    endif()
+  endforeach()
+endfunction()
+
+set(is_input "is the input '")
+expect_refused("${FUSE}" "${is_input}contacts.csv'" contacts.csv contacts.csv)
+expect_refused("${FUSE}" "${is_input}contacts.csv'" contacts.csv ./contacts.csv)
+file(CREATE_LINK contacts.csv "${WORK_DIR}/contacts_link.csv" SYMBOLIC)
+expect_refused("${FUSE}" "${is_input}contacts.csv'" contacts.csv contacts_link.csv)
+run_tool("${SIMULATE}" 0 --contacts 500 --seed 2 --readings r.npy --poses p.csv c5.csv)
+expect_refused("${FUSE}" "${is_input}p.csv'" --readings r.npy --poses p.csv p.csv)
+expect_refused("${FUSE}" "${is_input}r.npy'" --readings r.npy --poses p.csv r.npy)
+expect_refused("${ICP}" "${is_input}truth.ply'" cloud.ply truth.ply -o truth.ply)
+expect_refused("${DESCRIBE}" "${is_input}image.csv'" -o image.csv image.csv)
+expect_refused("${TRAIN}" "${is_input}data.libsvm'" -q data.libsvm data.libsvm)
+expect_refused("${PREDICT}" "${is_input}data.model'" data.libsvm data.model data.model)
+set(same "are the same file")
+expect_refused("${SIMULATE}" "${same}" --contacts 500 c6.csv c6.csv)
+expect_refused("${SIMULATE}" "${same}" --contacts 500 --readings r6.npy --poses r6.npy c6.csv)
+expect_refused("${SIMULATE}" "${same}" --contacts 500 --poses c6.csv c6.csv)
