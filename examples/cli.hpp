@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Shared command-line plumbing of the example tools: one-line errors with the tool's name and
 // an exit code, option values, strictly parsed numbers and lengths with units, standard streams
-// for "-" (report.hpp: the results as text, JSON or CSV).
+// for "-", outputs that would replace an input refused (report.hpp: the results as text, JSON or
+// CSV).
 #pragma once
 
 #include <algorithm>
@@ -106,7 +107,6 @@ inline bool parse_length(std::string_view text, double& metres) {
   return true;
 }
 
-/// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).
 /// True when the paths `a` and `b` name the same file: an existing one (hard or symbolic links
 /// included), or the same path once made absolute and resolved ("./x" and "x"). Standard
 /// streams ("-") and empty names are no files.
@@ -143,6 +143,7 @@ std::string output_conflict(std::string_view output, const Inputs& inputs,
   return {};
 }
 
+/// Walks argv. Errors print "<tool>: <why>" on one line and exit (2 by default: bad usage).
 class Args {
  public:
   Args(const char* tool, int argc, char** argv) : tool_(tool), argc_(argc), argv_(argv) {}
