@@ -351,25 +351,25 @@ void fusion_section(const std::vector<Object>& objects, bool quick, const fs::pa
                       fmt("%+.3f", 1e3 * r.m.error.signed_mean)});
       files.push_back(r.object + "_" + r.policy + ".ply");
     }
-    const PointCloud<double>& kalman = fused[i].surfel;
+    const PointCloud<double>& surfel = fused[i].surfel;
     const std::vector<double>& err = fused[i].error;
     io::CloudView view;
-    view.title = o.name + ": Surfel cloud, " + std::to_string(kalman.size()) + " points";
+    view.title = o.name + ": Surfel cloud, " + std::to_string(surfel.size()) + " points";
     view.value_label = "error mm";
     view.value_min = 0.0;
-    io::write_file((out / (o.name + "_kalman.svg")).string(),
-                   io::render_cloud_svg(kalman.points, err, view));
+    io::write_file((out / (o.name + "_surfel.svg")).string(),
+                   io::render_cloud_svg(surfel.points, err, view));
     // The colour scale: up to the 95th percentile of the errors (at least 0.05 mm).
     std::vector<double> sorted = err;
     std::sort(sorted.begin(), sorted.end());
     const double top = std::max(0.05, sorted.empty() ? 0.0 : sorted[sorted.size() * 95 / 100]);
     views.push_back(taxel_demo::view_html(
         "view-" + o.name,
-        o.name + ": the Surfel-fused cloud (" + std::to_string(kalman.size()) +
+        o.name + ": the Surfel-fused cloud (" + std::to_string(surfel.size()) +
             " points), coloured by its distance to the true surface; drag to turn, wheel to "
             "zoom (<a href=\"" +
-            o.name + "_kalman.svg\">as SVG</a>)",
-        {taxel_demo::ramp_layer(kalman.points, err, top)}, top, "mm and above"));
+            o.name + "_surfel.svg\">as SVG</a>)",
+        {taxel_demo::ramp_layer(surfel.points, err, top)}, top, "mm and above"));
   }
   page.heading("1. Contact fusion: raw, averaging, Kalman and Surfel");
   page.para(

@@ -6,7 +6,7 @@ run_tool("${DEMO}" 0 --quick out)
 # Every file the page shows or links.
 set(files index.html error_vs_contacts.svg)
 foreach(object sphere-40 cylinder-30x100 box-80x60x40 cone-30x60)
-  list(APPEND files ${object}_kalman.svg)
+  list(APPEND files ${object}_surfel.svg)
   foreach(policy raw average kalman)
     list(APPEND files ${object}_${policy}.ply)
   endforeach()
