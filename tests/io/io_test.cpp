@@ -170,8 +170,11 @@ TEST_CASE("NPY images: dtypes, stacks, Fortran order, versions, strict errors", 
                     Contains("x.npy: byte 0") && Contains("magic"));
   CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(2, 3)", "abc")), Contains("truncated"));
   CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(1, 2)", "abc")), Contains("1 unexpected bytes"));
-  CHECK_THROWS_WITH(tio::parse_npy(npy(">f8", "(1, 1)", std::string(8, '\0'))),
-                    Contains("big-endian"));
+  // Big-endian values (numpy's '>' byte order).
+  CHECK(
+      tio::parse_npy(npy(">f8", "(1, 1)", std::string("\xc0\x02\0\0\0\0\0\0", 8))).frame(0)(0, 0) ==
+      -2.25);
+  CHECK(tio::parse_npy(npy(">i2", "(1, 1)", std::string("\xff\xfe", 2))).frame(0)(0, 0) == -2);
   CHECK_THROWS_WITH(tio::parse_npy(npy("<c16", "(1, 1)", std::string(16, '\0'))),
                     Contains("unsupported dtype"));
   CHECK_THROWS_WITH(tio::parse_npy(npy("|u1", "(1, 1, 1, 1)", "a")), Contains("dimension"));

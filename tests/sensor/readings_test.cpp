@@ -65,6 +65,26 @@ TEST_CASE("npy: the dtypes numpy writes for readings, both byte orders, versions
   const auto d = tio::parse_npy_u16(
       npy("{'descr': '|u1', 'fortran_order': False, 'shape': (0, 14, 6), }", ""));
   CHECK(d.values.empty());
+  // Fortran order (np.asfortranarray, or a transposed array saved as it is): the first index
+  // varies fastest in the file; the values come back in C order. A (2, 3, 2) array whose value
+  // at (i, j, k) is 100 i + 10 j + k.
+  std::vector<std::uint16_t> column_major, row_major;
+  for (int k = 0; k < 2; ++k) {
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 2; ++i) column_major.push_back(std::uint16_t(100 * i + 10 * j + k));
+    }
+  }
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 2; ++k) row_major.push_back(std::uint16_t(100 * i + 10 * j + k));
+    }
+  }
+  std::string data;
+  for (const std::uint16_t v : column_major) data += bytes_of<std::uint16_t>({v}, true);
+  const auto f = tio::parse_npy_u16(
+      npy("{'descr': '>u2', 'fortran_order': True, 'shape': (2, 3, 2), }", data));
+  CHECK(f.shape == std::vector<std::size_t>{2, 3, 2});
+  CHECK(f.values == row_major);
   // The encoder's output reads back and has numpy's layout.
   const std::size_t shape[3] = {2, 1, 3};
   const std::uint16_t vals[6] = {1, 2, 3, 4, 5, 65535};
@@ -95,12 +115,12 @@ TEST_CASE("npy: malformed files and values that are no readings are refused with
   refused("PK\x03\x04 not numpy", "not a .npy file");
   refused(npy(u2, bytes_of<std::uint16_t>({1})), "needs 4 data bytes, the file has 2");
   refused(npy(u2, bytes_of<std::uint16_t>({1, 2, 3})), "needs 4 data bytes, the file has 6");
-  refused(npy(u2, "").substr(0, 30), "truncated header");
-  refused(npy("{'descr': '<u2', 'fortran_order': True, 'shape': (2,), }",
-              bytes_of<std::uint16_t>({1, 2})),
-          "Fortran-ordered");
+  refused(npy(u2, "").substr(0, 30), "byte 10: truncated header");
+  refused(
+      npy("{'descr': '<u2', 'fortran_order': 1, 'shape': (2,), }", bytes_of<std::uint16_t>({1, 2})),
+      "fortran_order must be True or False");
   refused(npy("{'descr': '<c16', 'fortran_order': False, 'shape': (1,), }", std::string(16, '\0')),
-          "is not supported");
+          "unsupported dtype '<c16'");
   refused(npy("{'descr': '<i2', 'fortran_order': False, 'shape': (2,), }",
               bytes_of<std::int16_t>({3, -1})),
           "value -1.000000 at flat index 1");

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Pressure images from CSV, PGM (P2/P5, 8 or 16 bit) and NPY (2-D image or 3-D stack of frames,
-// little-endian integers and floats), read strictly: every error says where (line and column,
+// integers and floats), read strictly: every error says where (line and column,
 // or byte offset) and what was expected. Writers for PGM and NPY; PNG is in io/png.hpp.
 //
 // CSV layout: one image row per line, values separated by commas (spaces and tabs around them
@@ -23,6 +23,7 @@
 #include "taxel/core/error.hpp"
 #include "taxel/image/types.hpp"
 #include "taxel/io/file.hpp"
+#include "taxel/io/npy.hpp"
 
 namespace taxel::io {
 
@@ -230,181 +231,40 @@ inline ImageStack parse_pgm(std::string_view bytes, const std::string& source = 
 }
 
 /// Parses a NumPy .npy file (format versions 1.0, 2.0 and 3.0): a 2-D array (rows, cols) or a
-/// 3-D stack (frames, rows, cols) of little-endian or byte-wide integers ('u1', 'i1', 'u2',
-/// 'i2', 'u4', 'i4', 'u8', 'i8') or floats ('f4', 'f8'), C or Fortran order. Non-finite floats
-/// are refused. Throws IoError with the byte offset of the first error.
+/// 3-D stack (frames, rows, cols) of integers ('u1', 'i1', 'u2', 'i2', 'u4', 'i4', 'u8', 'i8')
+/// or floats ('f4', 'f8') in either byte order, C or Fortran order (see io/npy.hpp).
+/// Non-finite floats are refused. Throws IoError with the byte offset of the first error.
 template <class = void>
 inline ImageStack parse_npy(std::string_view bytes, const std::string& source = "<npy>") {
-  static constexpr char kMagic[] = "\x93NUMPY";
-  if (bytes.size() < 10 || bytes.substr(0, 6) != std::string_view(kMagic, 6)) {
-    detail::fail_at_byte(source, 0, "not an NPY file: the magic string \\x93NUMPY is missing");
-  }
-  const int major = static_cast<unsigned char>(bytes[6]);
-  if (major < 1 || major > 3) {
-    detail::fail_at_byte(source, 6, "unsupported NPY format version " + std::to_string(major));
-  }
-  std::size_t header_len = 0;
-  std::size_t pos = 0;
-  if (major == 1) {
-    header_len = static_cast<unsigned char>(bytes[8]) |
-                 (static_cast<std::size_t>(static_cast<unsigned char>(bytes[9])) << 8);
-    pos = 10;
-  } else {
-    if (bytes.size() < 12) detail::fail_at_byte(source, 8, "truncated header length");
-    for (int i = 3; i >= 0; --i) {
-      header_len =
-          (header_len << 8) | static_cast<unsigned char>(bytes[8 + static_cast<std::size_t>(i)]);
-    }
-    pos = 12;
-  }
-  if (header_len > bytes.size() - pos) {
-    detail::fail_at_byte(source, pos,
-                         "truncated: header of " + std::to_string(header_len) +
-                             " bytes runs past the end of the file");
-  }
-  const std::string_view header = bytes.substr(pos, header_len);
-  const std::size_t data_start = pos + header_len;
-
-  // The header is a Python dict literal: {'descr': '<f8', 'fortran_order': False, 'shape': (..)}
-  auto value_of = [&](std::string_view key) -> std::pair<std::string_view, std::size_t> {
-    std::string quoted;  // append(): GCC 12 misreports -Wrestrict on "'" + std::string
-    quoted.append("'").append(key).append("'");
-    const auto k = header.find(quoted);
-    if (k == std::string_view::npos) {
-      detail::fail_at_byte(source, pos, "header lacks the key " + quoted);
-    }
-    auto v = header.find(':', k + quoted.size());
-    if (v == std::string_view::npos) detail::fail_at_byte(source, pos + k, "expected ':'");
-    ++v;
-    while (v < header.size() && header[v] == ' ') ++v;
-    return {header.substr(v), pos + v};
-  };
-  const auto [descr_text, descr_at] = value_of("descr");
-  if (descr_text.size() < 5 || descr_text[0] != '\'') {
-    detail::fail_at_byte(source, descr_at, "descr must be a quoted type string such as '<f8'");
-  }
-  const std::string_view descr = descr_text.substr(1, descr_text.find('\'', 1) - 1);
-  if (descr.size() != 3) {
-    detail::fail_at_byte(source, descr_at, "unsupported dtype '" + std::string(descr) + "'");
-  }
-  const char order = descr[0];
-  const char kind = descr[1];
-  const int width = descr[2] - '0';
-  const bool known = (kind == 'u' || kind == 'i')
-                         ? (width == 1 || width == 2 || width == 4 || width == 8)
-                         : (kind == 'f' && (width == 4 || width == 8));
-  if (!known) {
-    detail::fail_at_byte(source, descr_at,
-                         "unsupported dtype '" + std::string(descr) +
-                             "': use u1, i1, u2, i2, u4, i4, u8, i8, f4 or f8");
-  }
-  if (order == '>' && width > 1) {
-    detail::fail_at_byte(source, descr_at,
-                         "big-endian dtype '" + std::string(descr) + "' is not supported");
-  }
-  if (order != '<' && order != '|' && order != '>') {
-    detail::fail_at_byte(source, descr_at, "bad byte-order mark in '" + std::string(descr) + "'");
-  }
-  const auto [fortran_text, fortran_at] = value_of("fortran_order");
-  bool fortran = false;
-  if (fortran_text.substr(0, 4) == "True") {
-    fortran = true;
-  } else if (fortran_text.substr(0, 5) != "False") {
-    detail::fail_at_byte(source, fortran_at, "fortran_order must be True or False");
-  }
-  const auto [shape_text, shape_at] = value_of("shape");
-  if (shape_text.empty() || shape_text[0] != '(') {
-    detail::fail_at_byte(source, shape_at, "shape must be a tuple");
-  }
-  std::vector<std::uint64_t> shape;
-  std::size_t i = 1;
-  while (true) {
-    while (i < shape_text.size() && (shape_text[i] == ' ' || shape_text[i] == ',')) ++i;
-    if (i < shape_text.size() && shape_text[i] == ')') break;
-    std::uint64_t v = 0;
-    const std::size_t start = i;
-    while (i < shape_text.size() && shape_text[i] >= '0' && shape_text[i] <= '9') {
-      v = v * 10 + static_cast<std::uint64_t>(shape_text[i] - '0');
-      if (v > kMaxImageValues) {
-        detail::fail_at_byte(source, shape_at + start, "dimension exceeds the size limit");
-      }
-      ++i;
-    }
-    if (i == start) detail::fail_at_byte(source, shape_at + i, "malformed shape tuple");
-    shape.push_back(v);
-    if (shape.size() > 3) break;
-  }
-  if (shape.size() != 2 && shape.size() != 3) {
-    detail::fail_at_byte(source, shape_at,
+  const NpyArray a = parse_npy_header(bytes, source, kMaxImageValues);
+  if (a.shape.size() != 2 && a.shape.size() != 3) {
+    detail::fail_at_byte(source, a.shape_at,
                          "expected a 2-D image or a 3-D stack of frames, got " +
-                             std::to_string(shape.size()) + " dimension(s)");
+                             std::to_string(a.shape.size()) + " dimension(s)");
   }
   ImageStack out;
-  const std::uint64_t frames = shape.size() == 3 ? shape[0] : 1;
-  const std::uint64_t rows = shape[shape.size() - 2];
-  const std::uint64_t cols = shape[shape.size() - 1];
-  detail::check_size(source, frames, rows, cols, shape_at);
-  const std::uint64_t n = frames * rows * cols;
-  const auto w = static_cast<std::uint64_t>(width);
-  if ((bytes.size() - data_start) / w < n) {
-    detail::fail_at_byte(source, bytes.size(),
-                         "truncated: shape needs " + std::to_string(n * w) + " data bytes, " +
-                             std::to_string(bytes.size() - data_start) + " remain");
-  }
-  if (bytes.size() - data_start != n * w) {
-    detail::fail_at_byte(
-        source, data_start + n * w,
-        std::to_string(bytes.size() - data_start - n * w) + " unexpected bytes after the data");
-  }
+  const std::uint64_t frames = a.shape.size() == 3 ? a.shape[0] : 1;
+  const std::uint64_t rows = a.shape[a.shape.size() - 2];
+  const std::uint64_t cols = a.shape[a.shape.size() - 1];
+  detail::check_size(source, frames, rows, cols, a.shape_at);
   out.frames = static_cast<Eigen::Index>(frames);
   out.rows = static_cast<Eigen::Index>(rows);
   out.cols = static_cast<Eigen::Index>(cols);
-  out.values.resize(n);
-  const char* p = bytes.data() + data_start;
-  for (std::uint64_t k = 0; k < n; ++k, p += width) {
-    std::uint64_t raw = 0;
-    for (int b = width - 1; b >= 0; --b) raw = (raw << 8) | static_cast<unsigned char>(p[b]);
-    double v = 0;
-    if (kind == 'u') {
-      v = static_cast<double>(raw);
-    } else if (kind == 'i') {
-      const unsigned shift = 64u - 8u * static_cast<unsigned>(width);
-      v = static_cast<double>(static_cast<std::int64_t>(raw << shift) >> shift);
-    } else if (width == 4) {
-      v = static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(raw)));
-    } else {
-      v = std::bit_cast<double>(raw);
-    }
-    if (!std::isfinite(v)) {  // name the pixel: (frame, row, column) of element k
-      const std::uint64_t per_frame = rows * cols;
-      std::uint64_t f = 0, r = 0, c = 0;
-      if (fortran) {
-        f = k % frames;
-        r = (k / frames) % rows;
-        c = k / (frames * rows);
-      } else {
-        f = k / per_frame;
-        r = (k % per_frame) / cols;
-        c = k % cols;
-      }
-      detail::fail_at_byte(source, static_cast<std::size_t>(p - bytes.data()),
-                           "pixel (row " + std::to_string(r) + ", column " + std::to_string(c) +
-                               ") of frame " + std::to_string(f) + " is not finite (" +
+  out.values.resize(a.count);
+  for (std::uint64_t k = 0; k < a.count; ++k) {
+    const double v = a.value(bytes, k);
+    const std::uint64_t i = a.flat_index(k);
+    if (!std::isfinite(v)) {  // name the pixel: (frame, row, column)
+      detail::fail_at_byte(source, a.data_at + k * static_cast<std::uint64_t>(a.width),
+                           "pixel (row " + std::to_string(i / cols % rows) + ", column " +
+                               std::to_string(i % cols) + ") of frame " +
+                               std::to_string(i / (rows * cols)) + " is not finite (" +
                                (std::isnan(v) ? "nan"
                                 : v > 0       ? "inf"
                                               : "-inf") +
                                ")");
     }
-    // Fortran order stores the whole array column-major: element (f, r, c) is at
-    // f + frames * (r + rows * c).
-    std::uint64_t dst = k;
-    if (fortran) {
-      const std::uint64_t f = k % frames;
-      const std::uint64_t r = (k / frames) % rows;
-      const std::uint64_t c = k / (frames * rows);
-      dst = (f * rows + r) * cols + c;
-    }
-    out.values[dst] = v;
+    out.values[i] = v;
   }
   return out;
 }
@@ -461,17 +321,10 @@ inline std::string encode_npy(const ImageStack& stack, NpyDtype dtype = NpyDtype
       }
     }
   }
-  std::string dict = std::string("{'descr': '") + descr + "', 'fortran_order': False, 'shape': (";
-  if (stack.frames != 1) dict += std::to_string(stack.frames) + ", ";
-  dict += std::to_string(stack.rows) + ", " + std::to_string(stack.cols) + "), }";
-  // Pad with spaces so that the data start at a multiple of 64 bytes, ending in '\n'.
-  const std::size_t total = (10 + dict.size() + 1 + 63) / 64 * 64;
-  dict.append(total - 10 - dict.size() - 1, ' ');
-  dict.push_back('\n');
-  std::string out("\x93NUMPY\x01\x00", 8);
-  out.push_back(static_cast<char>(dict.size() & 0xFF));
-  out.push_back(static_cast<char>(dict.size() >> 8));
-  out += dict;
+  std::string shape = "(";
+  if (stack.frames != 1) shape += std::to_string(stack.frames) + ", ";
+  shape += std::to_string(stack.rows) + ", " + std::to_string(stack.cols) + ")";
+  std::string out = detail_npy::header_v1(descr, shape);
   for (double v : stack.values) {
     if (dtype == NpyDtype::u1) {
       out.push_back(static_cast<char>(static_cast<std::uint8_t>(v)));

@@ -10,10 +10,12 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "taxel/core/error.hpp"
@@ -27,28 +29,76 @@ struct NpyU16 {
   std::vector<std::uint16_t> values;  ///< product(shape) values
 };
 
+/// What a .npy file's header says about its array, and where the values start: the one reader
+/// of the format behind parse_npy_u16 (readings) and io/image.hpp's parse_npy (images).
+struct NpyArray {
+  char kind = 'u';                   ///< 'u' unsigned, 'i' signed integer, 'f' floating point
+  int width = 1;                     ///< bytes per value: 1, 2, 4 or 8
+  bool big_endian = false;           ///< byte order of the values
+  bool fortran_order = false;        ///< stored column-major (the first index varies fastest)
+  std::vector<std::uint64_t> shape;  ///< dimensions, outermost first
+  std::uint64_t count = 1;           ///< number of values, the product of shape
+  std::size_t data_at = 0;           ///< byte offset of the first value
+  std::size_t shape_at = 0;          ///< byte offset of the shape in the header
+
+  /// The value stored `k`-th in the file, converted to double (exact for integers below 2^53).
+  [[nodiscard]] double value(std::string_view bytes, std::uint64_t k) const noexcept {
+    const auto* p = reinterpret_cast<const unsigned char*>(bytes.data()) + data_at +
+                    k * static_cast<std::uint64_t>(width);
+    std::uint64_t raw = 0;
+    for (int b = 0; b < width; ++b) {
+      raw |= std::uint64_t{p[b]} << (8 * (big_endian ? width - 1 - b : b));
+    }
+    if (kind == 'u') return static_cast<double>(raw);
+    if (kind == 'i') {
+      const int shift = 64 - 8 * width;  // sign-extend
+      return static_cast<double>(static_cast<std::int64_t>(raw << shift) >> shift);
+    }
+    if (width == 4)
+      return static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(raw)));
+    return std::bit_cast<double>(raw);
+  }
+
+  /// The row-major (C order, numpy's `flat`) index of the value stored `k`-th in the file.
+  [[nodiscard]] std::uint64_t flat_index(std::uint64_t k) const noexcept {
+    if (!fortran_order) return k;
+    std::uint64_t index = 0, stride = 1;
+    for (std::size_t d = shape.size(); d-- > 0;) stride *= shape[d];
+    for (const std::uint64_t n : shape) {  // the first dimension varies fastest in the file
+      stride /= n;
+      index += (k % n) * stride;
+      k /= n;
+    }
+    return index;
+  }
+};
+
 namespace detail_npy {
 
-[[noreturn]] inline void fail(const std::string& source, const std::string& why) {
-  throw IoError(source, why);
+[[noreturn]] inline void fail(const std::string& source, std::size_t at, const std::string& why) {
+  throw IoError(source, why, std::nullopt, at);
 }
 
-// The value of `key` in the header dict, up to the next top-level ',' or '}' (a tuple kept
-// whole).
-inline std::string_view dict_value(std::string_view header, std::string_view key,
-                                   const std::string& source) {
+// The value of `key` in the header dict (Python literal), up to the next top-level ',' or '}'
+// (a tuple kept whole), and its byte offset in the file (`base` is the header's).
+inline std::pair<std::string_view, std::size_t> dict_value(std::string_view header,
+                                                           std::size_t base, std::string_view key,
+                                                           const std::string& source) {
   std::size_t at = std::string_view::npos;
   for (const char q : {'\'', '"'}) {
-    const std::string quoted = std::string(1, q) + std::string(key) + q;
+    std::string quoted;  // append(): GCC 12 misreports -Wrestrict on "'" + std::string
+    quoted.append(1, q).append(key).append(1, q);
     at = header.find(quoted);
     if (at != std::string_view::npos) {
       at += quoted.size();
       break;
     }
   }
-  if (at == std::string_view::npos) fail(source, "header has no '" + std::string(key) + "'");
+  if (at == std::string_view::npos) fail(source, base, "header has no '" + std::string(key) + "'");
   at = header.find(':', at);
-  if (at == std::string_view::npos) fail(source, "header: no ':' after '" + std::string(key) + "'");
+  if (at == std::string_view::npos) {
+    fail(source, base, "header: no ':' after '" + std::string(key) + "'");
+  }
   ++at;
   while (at < header.size() && header[at] == ' ') ++at;
   std::size_t end = at;
@@ -60,73 +110,108 @@ inline std::string_view dict_value(std::string_view header, std::string_view key
     if (depth == 0 && (c == ',' || c == '}')) break;
     ++end;
   }
-  if (end >= header.size())
-    fail(source, "header: unterminated value of '" + std::string(key) + "'");
+  if (end >= header.size()) {
+    fail(source, base + at, "header: unterminated value of '" + std::string(key) + "'");
+  }
   std::string_view v = header.substr(at, end - at);
   while (!v.empty() && v.back() == ' ') v.remove_suffix(1);
-  return v;
+  return {v, base + at};
+}
+
+// The version 1.0 header of an array of `descr` ("<u2") and `shape` ("(3, 4)"), padded so
+// that the data start at a multiple of 64 bytes, as numpy writes it.
+inline std::string header_v1(std::string_view descr, std::string_view shape) {
+  std::string dict;  // append(): GCC 12 misreports -Wstringop-overflow on operator+ here
+  dict.append("{'descr': '").append(descr).append("', 'fortran_order': False, 'shape': ");
+  dict.append(shape).append(", }");
+  const std::size_t total = 10 + dict.size() + 1;
+  dict.append((64 - total % 64) % 64, ' ');
+  dict.push_back('\n');
+  std::string out("\x93NUMPY\x01\x00", 8);
+  out.push_back(static_cast<char>(dict.size() & 0xFF));
+  out.push_back(static_cast<char>(dict.size() >> 8));
+  return out.append(dict);
 }
 
 }  // namespace detail_npy
 
-/// Reads a .npy file of integer readings (dtype u1, u2, u4, u8, i1, i2, i4, i8 in either byte
-/// order, or f4 / f8 holding whole numbers) into 16-bit values. Throws IoError when the file
-/// cannot be read, and IoError naming the file and the problem for anything else: a bad
-/// magic or header, Fortran order, a shape whose size disagrees with the data, or a value that
-/// is negative, fractional, not finite or above 65535 (with its flat index).
-inline NpyU16 parse_npy_u16(std::string_view bytes, const std::string& source = "<npy>") {
+/// Reads the header of a .npy file (format versions 1.0, 2.0 and 3.0): dtype u1, u2, u4, u8,
+/// i1, i2, i4, i8, f4 or f8 in either byte order, C or Fortran order, any number of
+/// dimensions. Checks that exactly the values the shape holds follow the header, and that they
+/// are at most `max_count`. Throws IoError naming the file and the byte of the problem.
+inline NpyArray parse_npy_header(std::string_view bytes, const std::string& source,
+                                 std::uint64_t max_count) {
   using detail_npy::fail;
   if (bytes.size() < 10 || bytes.substr(0, 6) != std::string_view("\x93NUMPY", 6)) {
-    fail(source, "not a .npy file (no \\x93NUMPY magic)");
+    fail(source, 0, "not a .npy file: the magic string \\x93NUMPY is missing");
   }
   const auto major = static_cast<unsigned char>(bytes[6]);
-  std::size_t header_len = 0, offset = 0;
+  std::size_t header_len = 0, at = 10;
   if (major == 1) {
     header_len = static_cast<unsigned char>(bytes[8]) |
-                 (std::size_t(static_cast<unsigned char>(bytes[9])) << 8);
-    offset = 10;
+                 (std::size_t{static_cast<unsigned char>(bytes[9])} << 8);
   } else if (major == 2 || major == 3) {
-    if (bytes.size() < 12) fail(source, "truncated header");
-    header_len = 0;
+    if (bytes.size() < 12) fail(source, 8, "truncated header length");
     for (int k = 0; k < 4; ++k) {
-      header_len |= std::size_t(static_cast<unsigned char>(bytes[8 + k])) << (8 * k);
+      header_len |= std::size_t{static_cast<unsigned char>(bytes[8 + std::size_t(k)])} << (8 * k);
     }
-    offset = 12;
+    at = 12;
   } else {
-    fail(source, "unsupported .npy version " + std::to_string(major));
+    fail(source, 6, "unsupported .npy format version " + std::to_string(major));
   }
-  if (header_len > bytes.size() - offset) fail(source, "truncated header");
-  const std::string_view header = bytes.substr(offset, header_len);
-  offset += header_len;
+  if (header_len > bytes.size() - at) {
+    fail(source, at,
+         "truncated header: the header of " + std::to_string(header_len) +
+             " bytes runs past the end of the file");
+  }
+  const std::string_view header = bytes.substr(at, header_len);
+  NpyArray a;
+  a.data_at = at + header_len;
 
-  const std::string_view descr = detail_npy::dict_value(header, "descr", source);
+  const auto [descr, descr_at] = detail_npy::dict_value(header, at, "descr", source);
   if (descr.size() < 5 || (descr.front() != '\'' && descr.front() != '"') ||
       descr.back() != descr.front()) {
-    fail(source, "descr " + std::string(descr) + " is not a simple dtype string");
+    fail(source, descr_at,
+         "descr " + std::string(descr) + " is not a simple dtype string such as '<u2'");
   }
-  const std::string_view dtype = descr.substr(1, descr.size() - 2);  // e.g. <u2
+  const std::string_view dtype = descr.substr(1, descr.size() - 2);
+  a.kind = dtype[1];
+  a.width = dtype.size() == 3 && dtype[2] >= '1' && dtype[2] <= '8' ? dtype[2] - '0' : 0;
+  const bool known = (a.kind == 'u' || a.kind == 'i')
+                         ? (a.width == 1 || a.width == 2 || a.width == 4 || a.width == 8)
+                         : (a.kind == 'f' && (a.width == 4 || a.width == 8));
+  if (!known) {
+    fail(source, descr_at,
+         "unsupported dtype '" + std::string(dtype) +
+             "': use u1, i1, u2, i2, u4, i4, u8, i8, f4 or f8");
+  }
   const char order = dtype[0];
-  const char kind = dtype[1];
-  int width = 0;
-  if (dtype.size() == 3 && dtype[2] >= '1' && dtype[2] <= '8') width = dtype[2] - '0';
-  const bool int_ok =
-      (kind == 'u' || kind == 'i') && (width == 1 || width == 2 || width == 4 || width == 8);
-  const bool float_ok = kind == 'f' && (width == 4 || width == 8);
-  if ((order != '<' && order != '>' && order != '|' && order != '=') || !(int_ok || float_ok)) {
-    fail(source, "dtype '" + std::string(dtype) +
-                     "' is not supported; integer readings need u1/u2/u4/u8/i1/i2/i4/i8 or f4/f8");
+  if (order != '<' && order != '>' && order != '|' && order != '=') {
+    fail(source, descr_at, "bad byte-order mark in '" + std::string(dtype) + "'");
   }
-  const bool big = order == '>' || (order == '=' && std::endian::native == std::endian::big);
-  if (detail_npy::dict_value(header, "fortran_order", source) != "False") {
-    fail(source, "Fortran-ordered arrays are not supported; save with np.ascontiguousarray");
+  a.big_endian = order == '>' || (order == '=' && std::endian::native == std::endian::big);
+
+  const auto [fortran, fortran_at] = detail_npy::dict_value(header, at, "fortran_order", source);
+  if (fortran != "True" && fortran != "False") {
+    fail(source, fortran_at, "fortran_order must be True or False");
   }
-  const std::string_view shape_text = detail_npy::dict_value(header, "shape", source);
-  if (shape_text.size() < 2 || shape_text.front() != '(' || shape_text.back() != ')') {
-    fail(source, "shape " + std::string(shape_text) + " is not a tuple");
+  a.fortran_order = fortran == "True";
+
+  // Not a structured binding: the lambda below uses it, which clang before 16 refuses.
+  const std::pair<std::string_view, std::size_t> shape_entry =
+      detail_npy::dict_value(header, at, "shape", source);
+  const std::string_view shape = shape_entry.first;
+  const std::size_t shape_at = shape_entry.second;
+  a.shape_at = shape_at;
+  if (shape.size() < 2 || shape.front() != '(' || shape.back() != ')') {
+    fail(source, shape_at, "shape " + std::string(shape) + " is not a tuple");
   }
-  NpyU16 out;
-  std::size_t count = 1;
-  std::string_view rest = shape_text.substr(1, shape_text.size() - 2);
+  const auto too_large = [&] {
+    fail(source, shape_at,
+         "shape " + std::string(shape) + " exceeds the limit of " + std::to_string(max_count) +
+             " values");
+  };
+  std::string_view rest = shape.substr(1, shape.size() - 2);
   while (!rest.empty()) {
     const std::size_t comma = rest.find(',');
     std::string_view item = rest.substr(0, comma);
@@ -134,50 +219,50 @@ inline NpyU16 parse_npy_u16(std::string_view bytes, const std::string& source = 
     while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
     if (item.empty()) continue;
-    std::size_t d = 0;
+    std::uint64_t d = 0;
     for (const char c : item) {
-      if (c < '0' || c > '9' || d > (std::numeric_limits<std::uint32_t>::max() / 10)) {
-        fail(source, "shape " + std::string(shape_text) + " is not a tuple of sizes");
+      if (c < '0' || c > '9') {
+        fail(source, shape_at, "shape " + std::string(shape) + " is not a tuple of sizes");
       }
-      d = d * 10 + std::size_t(c - '0');
+      d = d * 10 + std::uint64_t(c - '0');
+      if (d > max_count) too_large();
     }
-    out.shape.push_back(d);
-    if (d != 0 && count > (std::size_t{1} << 40) / d) fail(source, "shape too large");
-    count *= d;
+    a.shape.push_back(d);
   }
-  const std::size_t need = count * std::size_t(width);
-  if (bytes.size() - offset != need) {
-    fail(source, "shape " + std::string(shape_text) + " needs " + std::to_string(need) +
-                     " data bytes, the file has " + std::to_string(bytes.size() - offset));
+  for (const std::uint64_t d : a.shape) {
+    if (d != 0 && a.count > max_count / d) too_large();
+    a.count *= d;
   }
-  out.values.resize(count);
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data() + offset);
-  for (std::size_t i = 0; i < count; ++i) {
-    std::uint64_t raw = 0;
-    for (int k = 0; k < width; ++k) {
-      const std::uint64_t byte = data[i * std::size_t(width) + std::size_t(k)];
-      raw |= byte << (8 * (big ? width - 1 - k : k));
-    }
-    double v = 0.0;
-    bool ok = true;
-    if (kind == 'u') {
-      ok = raw <= 65535;
-      v = double(raw);
-    } else if (kind == 'i') {
-      const int shift = 64 - 8 * width;
-      const auto s = static_cast<std::int64_t>(raw << shift) >> shift;  // sign-extend
-      ok = s >= 0 && s <= 65535;
-      v = double(s);
-    } else if (width == 4) {
-      v = double(std::bit_cast<float>(static_cast<std::uint32_t>(raw)));
-      ok = v >= 0 && v <= 65535 && v == std::floor(v);
-    } else {
-      v = std::bit_cast<double>(raw);
-      ok = v >= 0 && v <= 65535 && v == std::floor(v);
-    }
-    if (!ok) {
-      fail(source, "value " + std::to_string(v) + " at flat index " + std::to_string(i) +
-                       " is not a reading (a whole number in [0, 65535])");
+  const std::uint64_t need = a.count * std::uint64_t(a.width);
+  const std::uint64_t have = bytes.size() - a.data_at;
+  if (have != need) {
+    const std::string sizes = "shape " + std::string(shape) + " needs " + std::to_string(need) +
+                              " data bytes, the file has " + std::to_string(have);
+    if (have < need) fail(source, bytes.size(), "truncated: " + sizes);
+    fail(source, a.data_at + need,
+         sizes + ": " + std::to_string(have - need) + " unexpected bytes after the data");
+  }
+  return a;
+}
+
+/// Reads a .npy file of integer readings (dtype u1, u2, u4, u8, i1, i2, i4, i8 in either byte
+/// order, or f4 / f8 holding whole numbers; C or Fortran order, returned in C order) into
+/// 16-bit values. Throws IoError when the file cannot be read, and IoError naming the file,
+/// the byte and the problem for anything else: a bad magic or header, a shape whose size
+/// disagrees with the data, or a value that is negative, fractional, not finite or above
+/// 65535 (with its flat index, in C order as numpy's `flat`).
+inline NpyU16 parse_npy_u16(std::string_view bytes, const std::string& source = "<npy>") {
+  const NpyArray a = parse_npy_header(bytes, source, std::uint64_t{1} << 40);
+  NpyU16 out;
+  out.shape.assign(a.shape.begin(), a.shape.end());
+  out.values.resize(a.count);
+  for (std::uint64_t k = 0; k < a.count; ++k) {
+    const double v = a.value(bytes, k);
+    const std::uint64_t i = a.flat_index(k);
+    if (!(v >= 0 && v <= 65535 && v == std::floor(v))) {
+      detail_npy::fail(source, a.data_at + k * std::uint64_t(a.width),
+                       "value " + std::to_string(v) + " at flat index " + std::to_string(i) +
+                           " is not a reading (a whole number in [0, 65535])");
     }
     out.values[i] = static_cast<std::uint16_t>(v);
   }
@@ -204,16 +289,7 @@ inline std::string encode_npy_u16(std::span<const std::size_t> shape,
   }
   // "(3, 4)" and "(5,)", as numpy writes them.
   if (shape.size() == 1) dims.push_back(',');
-  std::string header;  // append(): GCC 12 misreports -Wstringop-overflow on operator+ here
-  header.append("{'descr': '<u2', 'fortran_order': False, 'shape': (").append(dims).append("), }");
-  // Pad with spaces and a newline so that the data start at a multiple of 64 bytes.
-  const std::size_t total = 10 + header.size() + 1;
-  header.append((64 - total % 64) % 64, ' ');
-  header.push_back('\n');
-  std::string out("\x93NUMPY\x01\x00", 8);
-  out.push_back(static_cast<char>(header.size() & 0xFF));
-  out.push_back(static_cast<char>(header.size() >> 8));
-  out += header;
+  std::string out = detail_npy::header_v1("<u2", "(" + dims + ")");
   for (const std::uint16_t v : values) {
     out.push_back(static_cast<char>(v & 0xFF));
     out.push_back(static_cast<char>(v >> 8));
