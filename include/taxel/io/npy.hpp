@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// NumPy .npy arrays of integer readings: a stack of tactile frames as numpy saves it
-// (np.save("readings.npy", frames), frames of shape (frames, rows, cols) or
+// NumPy .npy arrays: the format's one reader (parse_npy_header, also behind io/image.hpp's
+// pressure images) and the arrays of integer readings, a stack of tactile frames as numpy saves
+// it (np.save("readings.npy", frames), frames of shape (frames, rows, cols) or
 // (frames, pads, rows, cols)). Format: NEP 1, "A simple file format for NumPy arrays",
 // versions 1.0, 2.0 and 3.0.
 #pragma once
