@@ -114,7 +114,10 @@ int emulate(const Shape& shape, const Options& o, const taxel_cli::Args& args) {
   td::DsaconEmulator emulator(cfg, [&](std::uint64_t i) {
     return i < hand.frames.size() ? hand.frames[i] : std::vector<std::uint16_t>(cells, 0);
   });
-  auto [host, device] = td::LoopbackTransport::pair();
+  // Not a structured binding: the lambda below uses `device`, which clang before 16 refuses.
+  std::pair<td::LoopbackTransport, td::LoopbackTransport> link = td::LoopbackTransport::pair();
+  td::LoopbackTransport& host = link.first;
+  td::LoopbackTransport& device = link.second;
   device.open();
   std::atomic<bool> stop{false};
   std::thread controller([&] { emulator.serve(device, stop, true); });

@@ -202,10 +202,10 @@ palm-grasp pressure-image synthesiser.)doc");
       }),
       py::arg("vertices"), py::arg("triangles"));
   shape_methods(mesh);
-  m.def("icosphere", &sm::icosphere, py::arg("radius"), py::arg("subdivisions"),
+  m.def("icosphere", &sm::icosphere<>, py::arg("radius"), py::arg("subdivisions"),
         "A sphere mesh: an icosahedron subdivided `subdivisions` times, vertices on the sphere.");
-  m.def("box_mesh", &sm::box_mesh, py::arg("box"), "The box as a mesh of 12 triangles.");
-  m.def("cylinder_mesh", &sm::cylinder_mesh, py::arg("cylinder"), py::arg("segments"),
+  m.def("box_mesh", &sm::box_mesh<>, py::arg("box"), "The box as a mesh of 12 triangles.");
+  m.def("cylinder_mesh", &sm::cylinder_mesh<>, py::arg("cylinder"), py::arg("segments"),
         "The capped cylinder as a mesh with `segments` sides.");
 
   m.def(
