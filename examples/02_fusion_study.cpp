@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstdarg>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -30,15 +29,7 @@ namespace {
 using namespace taxel;
 namespace tf = taxel::fusion;
 
-// printf into a string: each job writes its own lines, printed in a fixed order afterwards.
-[[gnu::format(printf, 2, 3)]] void appendf(std::string& to, const char* fmt, ...) {
-  char buf[512];
-  va_list ap;
-  va_start(ap, fmt);
-  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  if (n > 0) to.append(buf, std::min<std::size_t>(static_cast<std::size_t>(n), sizeof buf - 1));
-}
+using taxel_cli::appendf;
 
 struct Row {
   sim::ReconstructionMetrics m;

@@ -14,6 +14,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -103,14 +104,16 @@ Options parse(int argc, char** argv) {
 std::string g_report;
 // Threads for the folds, replications and noise levels (--threads).
 unsigned g_threads = 0;
-void say(const char* fmt, auto... args) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, fmt, args...);
-  std::fputs(buf, stdout);
+[[gnu::format(printf, 1, 2)]] void say(const char* fmt, ...) {
+  std::string line;
+  va_list ap;
+  va_start(ap, fmt);
+  taxel_cli::vappendf(line, fmt, ap);
+  va_end(ap);
+  std::fputs(line.c_str(), stdout);
   std::fflush(stdout);
-  g_report += buf;
+  g_report += line;
 }
-
 // Progress on standard error, overwritten in place (from any thread).
 void progress(const char* stage, std::size_t done, std::size_t total) {
   static std::mutex mutex;

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -24,6 +25,29 @@
 #include <vector>
 
 namespace taxel_cli {
+
+/// vprintf into a string, appended whole however long the text.
+[[gnu::format(printf, 2, 0)]] inline void vappendf(std::string& to, const char* fmt, va_list ap) {
+  va_list again;
+  va_copy(again, ap);
+  const int n = std::vsnprintf(nullptr, 0, fmt, ap);
+  if (n > 0) {
+    const std::size_t at = to.size();
+    to.resize(at + static_cast<std::size_t>(n) + 1);
+    std::vsnprintf(to.data() + at, static_cast<std::size_t>(n) + 1, fmt, again);
+    to.resize(at + static_cast<std::size_t>(n));
+  }
+  va_end(again);
+}
+
+/// printf into a string (the studies gather each job's lines and print them in a fixed order
+/// afterwards).
+[[gnu::format(printf, 2, 3)]] inline void appendf(std::string& to, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vappendf(to, fmt, ap);
+  va_end(ap);
+}
 
 /// Makes a lost write to standard output an error, as a lost file write is: at exit (after
 /// `return` from main or std::exit), flushes standard output and, when any write to it failed
