@@ -6,9 +6,15 @@
 
 #include <atomic>
 
+// GCC says so by __SANITIZE_ADDRESS__, clang (before 17) only by __has_feature.
 #if defined(__SANITIZE_ADDRESS__)
 #define TAXEL_TEST_COUNTS_ALLOCATIONS 0
-#else
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TAXEL_TEST_COUNTS_ALLOCATIONS 0
+#endif
+#endif
+#ifndef TAXEL_TEST_COUNTS_ALLOCATIONS
 #define TAXEL_TEST_COUNTS_ALLOCATIONS 1
 #endif
 
