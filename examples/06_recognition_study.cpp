@@ -114,6 +114,7 @@ unsigned g_threads = 0;
   std::fflush(stdout);
   g_report += line;
 }
+
 // Progress on standard error, overwritten in place (from any thread).
 void progress(const char* stage, std::size_t done, std::size_t total) {
   static std::mutex mutex;
