@@ -56,8 +56,8 @@ foreach(kind cmake pkgconfig subdir)
     run("${build}/consumer_drivers")
   endif()
 endforeach()
-# A consumer of ten translation units, each including all of taxel and calling a different
-# part of it: every header must be safe to include in many files of one program.
+# A consumer of three translation units, each including all of taxel and calling different
+# parts of it: every header must be safe to include in many files of one program.
 set(build "${WORK_DIR}/build_units")
 run(${CMAKE_COMMAND} -S "${consumers}/units" -B "${build}" "-DCMAKE_PREFIX_PATH=${prefix}"
     "-DCMAKE_CXX_COMPILER=${CMAKE_CXX_COMPILER}" -DCMAKE_BUILD_TYPE=Release)
