@@ -125,11 +125,14 @@ double rms_of_first(const std::vector<double>& e, std::size_t m) {
 }
 
 // The largest rise, from one checkpoint to the next, of the RMS over the points the earlier
-// one had (a cloud only appends points, so they are its first ones in the later cloud).
-double largest_rise_of_kept_points(const std::vector<std::vector<double>>& errors) {
+// one had (a cloud only appends points, so they are its first ones in the later cloud), over
+// the checkpoints that had at least `min_points` points.
+double largest_rise_of_kept_points(const std::vector<std::vector<double>>& errors,
+                                   std::size_t min_points = 0) {
   double rise = 0;
   for (std::size_t k = 1; k < errors.size(); ++k) {
     const std::size_t m = errors[k - 1].size();
+    if (m == 0 || m < min_points) continue;
     rise = std::max(rise, rms_of_first(errors[k], m) / rms_of_first(errors[k - 1], m) - 1.0);
   }
   return rise;
@@ -267,6 +270,7 @@ struct PadLine {
   // Surfel against contacts (prefixes of 1/64, 1/32, .. of the stream, then all of it): the
   // largest rise of the RMS over every point, and over the points of the previous checkpoint.
   double rise_every = 0, rise_kept = 0;
+  double rise_kept_20 = 0;  // the same from checkpoints of at least 20 points
   std::string name;
   int seed = 0;
   DepthBands bands;     // the raw contacts by true depth (per tactel only)
@@ -317,6 +321,7 @@ PadLine pad_study(const char* name, const Shape& shape, bool quick, sim::Contact
   out.seed = int(seed);
   out.rise_every = largest_rise(every);
   out.rise_kept = largest_rise_of_kept_points(errors);
+  out.rise_kept_20 = largest_rise_of_kept_points(errors, 20);
   appendf(out.text,
           "%-26s %-10s %4d %8zu | %s | %s | %s | %s | %6.3f %6.3f | %3zu %6.3f %3zu %6.3f%s\n",
           name, mode == sim::ContactMode::per_tactel ? "per tactel" : "per pad", int(seed),
@@ -561,7 +566,7 @@ int main(int argc, char** argv) try {
       "over an earlier checkpoint, and of the RMS over the points of the previous checkpoint, "
       "then and now\n");
   for (std::size_t mode = 0; mode < 2; ++mode) {
-    double worst_every = 0, worst_kept = 0;
+    double worst_every = 0, worst_kept = 0, worst_kept_20 = 0;
     for (std::size_t shape = 0; shape < pads.size() / 6; ++shape) {
       std::printf("%-26s %-10s", pads[shape * 6 + mode * 3].name.c_str(),
                   mode == 0 ? "per tactel" : "per pad");
@@ -571,16 +576,23 @@ int main(int argc, char** argv) try {
                     100.0 * l.rise_every, 100.0 * l.rise_kept);
         worst_every = std::max(worst_every, l.rise_every);
         worst_kept = std::max(worst_kept, l.rise_kept);
+        worst_kept_20 = std::max(worst_kept_20, l.rise_kept_20);
       }
       std::printf("\n");
     }
-    std::printf("%s: largest rise %+.0f %% over every point, %+.0f %% over kept points\n",
-                mode == 0 ? "per tactel" : "per pad", 100.0 * worst_every, 100.0 * worst_kept);
+    std::printf(
+        "%s: largest rise %+.0f %% over every point, %+.0f %% over kept points (%+.0f %% from "
+        "the checkpoints of 20 points or more)\n",
+        mode == 0 ? "per tactel" : "per pad", 100.0 * worst_every, 100.0 * worst_kept,
+        100.0 * worst_kept_20);
   }
   std::printf(
       "The RMS over every point follows which regions the cloud has reached: grasps and light "
       "touches start points of few contacts. Over the points already there it rises most where "
-      "later contacts reach them across an edge (the box's, the cone's, the cylinder's rims).\n\n");
+      "later contacts reach them across an edge (the box's, the cone's, the cylinder's rims). "
+      "The first checkpoints hold a few points at about 0.01 mm, where a change of microns "
+      "reads as tens of percent; the figure in brackets leaves out the checkpoints of fewer "
+      "than 20 points.\n\n");
 
   // The mean over the seeds of every series.
   Study curve = curves[0];
