@@ -248,17 +248,26 @@ class ContactExtractor {
     return model_.sigma_normal * model_.sigma_normal + dq * dq / 12.0;
   }
 
+  // The noise terms every contact of a frame shares (see the model above, step 3), read once
+  // per frame: sigma_position^2, sigma_tilt^2 / 6 and / 3, and pitch^2 / 12.
+  struct SharedNoise {
+    double sp2, st2_6, st2_3, q2;
+  };
+  SharedNoise shared_noise() const {
+    const double st2 = model_.sigma_tilt * model_.sigma_tilt;
+    return {model_.sigma_position * model_.sigma_position, st2 / 6.0, st2 / 3.0, q2()};
+  }
+
   // The contact at pad point (x, y, -depth) with outward normal n_pad (pad frame), extra
   // variance along the normal and the slope variances of that normal.
   template <class = void>
-  void make(std::vector<Contact<double>>& out, const Eigen::Isometry3d& T, double x, double y,
-            double depth, const Vec3d& n_pad, double var_along, double var_across, double slope_var,
-            double pressure, double time) const {
+  [[gnu::always_inline]] void make(std::vector<Contact<double>>& out, const Eigen::Isometry3d& T,
+                                   const SharedNoise& sn, double x, double y, double depth,
+                                   const Vec3d& n_pad, double var_along, double slope_var,
+                                   double pressure, double time) const {
     const double lever2 = x * x + y * y;
-    const double st2 = model_.sigma_tilt * model_.sigma_tilt;
-    const double sp2 = model_.sigma_position * model_.sigma_position;
-    const double vt = var_across + sp2 + lever2 * st2 / 6.0;
-    const double vn = var_along + sp2 + lever2 * st2 / 3.0 + q2() * slope_var;
+    const double vt = sn.q2 + sn.sp2 + lever2 * sn.st2_6;
+    const double vn = var_along + sn.sp2 + lever2 * sn.st2_3 + sn.q2 * slope_var;
     Vec3d n = T.linear() * n_pad;       // unit already when T's rotation is orthonormal; made sure:
     const double n2 = n.squaredNorm();  // one Newton step for 1 / |n| when |n| is near 1
     n *= std::abs(n2 - 1.0) < 1e-6 ? 1.5 - 0.5 * n2 : 1.0 / std::sqrt(n2);
@@ -286,6 +295,7 @@ class ContactExtractor {
     const auto at_threshold = static_cast<std::size_t>(model_.threshold);
     const double threshold_bias = at_threshold < bias_.size() ? bias_[at_threshold] : 0.0;
     const double var_depth = refined_ ? vd : vd + threshold_bias * threshold_bias;
+    const SharedNoise sn = shared_noise();
     for (std::size_t i = 0; i < active_count_; ++i) {
       const Active& e = active_[i];
       double gx = 0, gy = 0, vgx = 0, vgy = 0;  // slopes of d per metre and their variances
@@ -321,7 +331,7 @@ class ContactExtractor {
       // The outward normal -(gx, gy, 1) / |(gx, gy, 1)|, with one division.
       const double scale = -1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
       const Vec3d n_pad(gx * scale, gy * scale, scale);
-      make(out, T, e.x * p, e.y * p, padded_[e.at], n_pad, var_depth, q2(), vgx + vgy, e.pressure,
+      make(out, T, sn, e.x * p, e.y * p, padded_[e.at], n_pad, var_depth, vgx + vgy, e.pressure,
            time);
     }
     return active_count_;
@@ -341,18 +351,14 @@ class ContactExtractor {
     // Pass 0's normal equations, on the plug-in depths: the moments of the active tactels'
     // coordinates, and the right-hand side.
     double* ata = factor_;  // factored in place, kept for per_pad
-    double sol[6] = {};
     normal_matrix(ata);
-    for (std::size_t i = 0; i < count; ++i) {
-      const double d = padded_[active_[i].at];
-      const double* row = monomials_[active_[i].tactel].data();
-      for (int a = 0; a < 6; ++a) sol[a] += row[a] * d;
-    }
+    double sol[6];
+    rhs(sol);
     const double n = static_cast<double>(count);
     double* inv_diag = factor_inv_diag_;
-    if (!detail_cholesky(ata, 6, inv_diag)) return;
+    if (!detail_cholesky(ata, inv_diag)) return;
     factored_ = true;
-    detail_solve(ata, 6, inv_diag, sol);
+    detail_solve(ata, inv_diag, sol);
     const double vd = depth_variance();
     const double half_v_over_sigma = 0.5 * vd / sigma, inv_sigma = 1.0 / sigma;
     // The correction at fitted depth f: d = measured - sigma lambda(a) + jensen lambda''(a),
@@ -376,25 +382,43 @@ class ContactExtractor {
     const auto fitted = [](const double* q, const Active& e) {
       return q[0] + e.x * (q[1] + q[3] * e.x + q[4] * e.y) + e.y * (q[2] + q[5] * e.y);
     };
+    // The leverages r' A^-1 r (r = 1, X, Y, X^2, XY, Y^2) as one quartic in the pad
+    // coordinates, whose 15 coefficients (from the entries of A^-1) are dotted with each
+    // tactel's monomials.
+    double bm[36];
+    inverse_normal_matrix(ata, inv_diag, bm);
+    const auto bb = [bm](int i, int j) { return bm[i * 6 + j]; };  // i >= j
+    const double lev[16] = {bb(0, 0),
+                            2 * bb(1, 0),
+                            2 * bb(2, 0),
+                            bb(1, 1) + 2 * bb(3, 0),
+                            2 * (bb(2, 1) + bb(4, 0)),
+                            bb(2, 2) + 2 * bb(5, 0),
+                            2 * bb(3, 1),
+                            2 * (bb(4, 1) + bb(3, 2)),
+                            2 * (bb(5, 1) + bb(4, 2)),
+                            2 * bb(5, 2),
+                            bb(3, 3),
+                            2 * bb(4, 3),
+                            bb(4, 4) + 2 * bb(5, 3),
+                            2 * bb(5, 4),
+                            bb(5, 5),
+                            0.0};
+    const Eigen::Map<const Eigen::Array<double, 16, 1>> lev_map(lev);
     // Pass 0: leverages, residuals, corrections at the first fit, pass 1's right-hand side.
-    double rss = 0, sol1[6] = {};
+    double rss = 0;
+    Vec6 sum1 = Vec6::Zero();
     for (std::size_t i = 0; i < count; ++i) {
       Active& e = active_[i];
       const double* row = monomials_[e.tactel].data();
-      double y[6] = {row[0], row[1], row[2], row[3], row[4], row[5]};
-      double h = 0;
-      for (int a = 0; a < 6; ++a) {  // leverage |L^-1 row|^2
-        for (int b = 0; b < a; ++b) y[a] -= ata[a * 6 + b] * y[b];
-        y[a] *= inv_diag[a];
-        h += y[a] * y[a];
-      }
+      const double h = (lev_map * Eigen::Map<const Eigen::Array<double, 16, 1>>(row)).sum();
       e.jensen = h * half_v_over_sigma;
       const double f = fitted(sol, e);
       const double res = padded_[e.at] - f;
       rss += res * res;
       correct(e, f, false);
       const double d = padded_[e.at];
-      for (int a = 0; a < 6; ++a) sol1[a] += row[a] * d;
+      sum1 += Eigen::Map<const Vec6>(row) * d;
     }
     // A chi-square test of the residuals, at about 3 standard deviations of their sum.
     if (!(rss <= vd * (n - 6 + 3 * std::sqrt(2 * (n - 6))))) {
@@ -407,7 +431,9 @@ class ContactExtractor {
     }
     refined_ = true;
     // Pass 1: the corrections at the refit.
-    detail_solve(ata, 6, inv_diag, sol1);
+    double sol1[6];
+    Vec6::Map(sol1) = sum1;
+    detail_solve(ata, inv_diag, sol1);
     // (Only the per-pad contact reads the corrected depths' variances; see the model, step 1.)
     const bool variances = options_.mode == ContactMode::per_pad;
     for (std::size_t i = 0; i < count; ++i) {
@@ -416,20 +442,10 @@ class ContactExtractor {
     // The refit gives the per-tactel normals: its gradient at (X, Y) is
     // (q1 + 2 q3 X + q4 Y, q2 + q4 X + 2 q5 Y) per pitch, with variances v e' A^-1 e for
     // e = (0, 1, 0, 2X, Y, 0) and (0, 0, 1, 0, X, 2Y): two quadratic forms in X and Y, whose
-    // coefficients come from the entries of A^-1 = L^-T L^-1 (columns of L^-1 by forward
-    // substitution), scaled to slopes per metre.
+    // coefficients come from the entries of A^-1 (above), scaled to slopes per metre.
     if (options_.mode != ContactMode::per_tactel || !options_.local_normals) return;
     for (int a = 0; a < 6; ++a) quad_[a] = sol1[a];
-    double col[6][6];
-    for (int k = 1; k < 6; ++k) {
-      for (int a = 0; a < 6; ++a) col[k][a] = a == k ? 1.0 : 0.0;
-      detail_forward_norm2(ata, 6, inv_diag, col[k]);
-    }
-    const auto inv = [&](int i, int j) {
-      double dot = 0;
-      for (int a = 0; a < 6; ++a) dot += col[i][a] * col[j][a];
-      return dot;
-    };
+    const auto inv = [&](int i, int j) { return i >= j ? bb(i, j) : bb(j, i); };
     const double scale = vd / (model_.geometry.pitch * model_.geometry.pitch);
     const double fx[6] = {inv(1, 1),     4 * inv(1, 3), 2 * inv(1, 4),
                           4 * inv(3, 3), 4 * inv(3, 4), inv(4, 4)};
@@ -442,14 +458,48 @@ class ContactExtractor {
     quad_ok_ = true;
   }
 
+  // The lower triangle of B = A^-1 = L^-T L^-1 (row stride 6) from the factor of
+  // detail_cholesky: L^-1 by forward substitution, then B_ij = sum over a >= i of
+  // (L^-1)_ai (L^-1)_aj. (The loops test their triangular bounds inside, so that they unroll
+  // in full without out-of-range iterations for the compiler to warn about.)
+  static void inverse_normal_matrix(const double* l, const double* inv_diag, double* inverse) {
+    double li[6][6] = {};  // li[a][k] = (L^-1)_ak, zero above the diagonal
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {
+#pragma GCC unroll 6
+      for (int a = 0; a < 6; ++a) {
+        if (a < k) continue;
+        double v = a == k ? 1.0 : 0.0;
+#pragma GCC unroll 6
+        for (int b = 0; b < 6; ++b) {
+          if (b >= k && b < a) v -= l[a * 6 + b] * li[b][k];
+        }
+        li[a][k] = v * inv_diag[a];
+      }
+    }
+#pragma GCC unroll 6
+    for (int i = 0; i < 6; ++i) {
+#pragma GCC unroll 6
+      for (int j = 0; j < 6; ++j) {
+        if (j > i) continue;
+        double v = 0;
+#pragma GCC unroll 6
+        for (int a = 0; a < 6; ++a) {
+          if (a >= i) v += li[a][i] * li[a][j];
+        }
+        inverse[i * 6 + j] = v;
+      }
+    }
+  }
+
   // The lower triangle (row stride 6; the upper one is not written) of the quadric fit's
   // normal matrix over the rows 1, X, Y, X^2, XY, Y^2 of the active tactels, from the sums of
   // their monomials.
   void normal_matrix(double* a) const {
-    double m[16] = {};
+    // (Summed as one fixed-size array, which stays in vector registers.)
+    Eigen::Array<double, 16, 1> m = Eigen::Array<double, 16, 1>::Zero();
     for (std::size_t i = 0; i < active_count_; ++i) {
-      const double* mono = monomials_[active_[i].tactel].data();
-      for (int k = 0; k < 16; ++k) m[k] += mono[k];
+      m += Eigen::Map<const Eigen::Array<double, 16, 1>>(monomials_[active_[i].tactel].data());
     }
     a[0] = m[0];
     a[6] = m[1], a[7] = m[3];
@@ -457,6 +507,17 @@ class ContactExtractor {
     a[18] = m[3], a[19] = m[6], a[20] = m[7], a[21] = m[10];
     a[24] = m[4], a[25] = m[7], a[26] = m[8], a[27] = m[11], a[28] = m[12];
     a[30] = m[5], a[31] = m[8], a[32] = m[9], a[33] = m[12], a[34] = m[13], a[35] = m[14];
+  }
+
+  // The normal equations' right-hand side: the sum of the active tactels' rows 1, X, Y, X^2,
+  // XY, Y^2 times their depths (one fixed-size array, kept in vector registers).
+  using Vec6 = Eigen::Array<double, 6, 1>;
+  void rhs(double* out) const {
+    Vec6 sum = Vec6::Zero();
+    for (std::size_t i = 0; i < active_count_; ++i) {
+      sum += Eigen::Map<const Vec6>(monomials_[active_[i].tactel].data()) * padded_[active_[i].at];
+    }
+    Vec6::Map(out) = sum;
   }
 
   double q2() const { return model_.geometry.pitch * model_.geometry.pitch / 12.0; }
@@ -495,17 +556,13 @@ class ContactExtractor {
     const double* inv_l = factor_inv_diag_;
     if (!factored_) {
       normal_matrix(local);
-      if (!detail_cholesky(local, 6, local_inv)) return per_tactel(T, time, out);
+      if (!detail_cholesky(local, local_inv)) return per_tactel(T, time, out);
       l = local;
       inv_l = local_inv;
     }
-    double sol[6] = {};
-    for (std::size_t i = 0; i < count; ++i) {
-      const double d = padded_[active_[i].at];
-      const double* row = monomials_[active_[i].tactel].data();
-      for (int a = 0; a < 6; ++a) sol[a] += row[a] * d;
-    }
-    detail_solve(l, 6, inv_l, sol);
+    double sol[6];
+    rhs(sol);
+    detail_solve(l, inv_l, sol);
     // The row at the centroid, and its derivatives along X and Y.
     double e0[6] = {1.0, xc, yc, xc * xc, xc * yc, yc * yc};
     double ex[6] = {0.0, 1.0, 0.0, 2.0 * xc, yc, 0.0};
@@ -514,7 +571,7 @@ class ContactExtractor {
     int k = 0;
     for (double* e : {e0, ex, ey}) {
       for (int a = 0; a < 6; ++a) fit[k] += e[a] * sol[a];
-      inv_diag[k++] = detail_forward_norm2(l, 6, inv_l, e);
+      inv_diag[k++] = detail_forward_norm2(l, inv_l, e);
     }
     double gx = 0, gy = 0, slope_var = 0.0;
     if (options_.local_normals) {
@@ -524,23 +581,28 @@ class ContactExtractor {
     }
     const Vec3d n_pad = -Vec3d(gx, gy, 1.0).normalized();
     const double var_a = vd * inv_diag[0] + std::max(corr2, 0.0) / (n * n);
-    make(out, T, xc * p, yc * p, fit[0], n_pad, var_a, q2(), slope_var, w, time);
+    make(out, T, shared_noise(), xc * p, yc * p, fit[0], n_pad, var_a, slope_var, w, time);
     return 1;
   }
 
-  // In-place Cholesky factor (lower triangle, row stride 6) of the leading m x m block, and the
-  // reciprocals of its diagonal; false when a pivot is not positive relative to its diagonal
-  // entry.
-  static bool detail_cholesky(double* a, int m, double* inv_diag) {
-    for (int j = 0; j < m; ++j) {
+  // The quadric fits' 6 x 6 linear algebra (row stride 6), with every loop unrolled in full.
+  static constexpr int kQuad = 6;
+  // In-place Cholesky factor (lower triangle) of a normal matrix, and the reciprocals of its
+  // diagonal; false when a pivot is not positive relative to its diagonal entry.
+  static bool detail_cholesky(double* a, double* inv_diag) {
+#pragma GCC unroll 6
+    for (int j = 0; j < kQuad; ++j) {
       double djj = a[j * 6 + j];
+#pragma GCC unroll 6
       for (int k = 0; k < j; ++k) djj -= a[j * 6 + k] * a[j * 6 + k];
       if (!(djj > 1e-10 * a[j * 6 + j])) return false;
       const double ljj = std::sqrt(djj);
       a[j * 6 + j] = ljj;
       inv_diag[j] = 1.0 / ljj;
-      for (int i = j + 1; i < m; ++i) {
+#pragma GCC unroll 6
+      for (int i = j + 1; i < kQuad; ++i) {
         double v = a[i * 6 + j];
+#pragma GCC unroll 6
         for (int k = 0; k < j; ++k) v -= a[i * 6 + k] * a[j * 6 + k];
         a[i * 6 + j] = v * inv_diag[j];
       }
@@ -548,21 +610,27 @@ class ContactExtractor {
     return true;
   }
   // Solves L L' x = b in place with the factor of detail_cholesky.
-  static void detail_solve(const double* l, int m, const double* inv_diag, double* b) {
-    for (int i = 0; i < m; ++i) {
+  static void detail_solve(const double* l, const double* inv_diag, double* b) {
+#pragma GCC unroll 6
+    for (int i = 0; i < kQuad; ++i) {
+#pragma GCC unroll 6
       for (int k = 0; k < i; ++k) b[i] -= l[i * 6 + k] * b[k];
       b[i] *= inv_diag[i];
     }
-    for (int i = m - 1; i >= 0; --i) {
-      for (int k = i + 1; k < m; ++k) b[i] -= l[k * 6 + i] * b[k];
+#pragma GCC unroll 6
+    for (int i = kQuad - 1; i >= 0; --i) {
+#pragma GCC unroll 6
+      for (int k = i + 1; k < kQuad; ++k) b[i] -= l[k * 6 + i] * b[k];
       b[i] *= inv_diag[i];
     }
   }
 
   // |L^-1 e|^2 by forward substitution with the factor of detail_cholesky; overwrites e.
-  static double detail_forward_norm2(const double* l, int m, const double* inv_diag, double* e) {
+  static double detail_forward_norm2(const double* l, const double* inv_diag, double* e) {
     double s = 0;
-    for (int i = 0; i < m; ++i) {
+#pragma GCC unroll 6
+    for (int i = 0; i < kQuad; ++i) {
+#pragma GCC unroll 6
       for (int k = 0; k < i; ++k) e[i] -= l[i * 6 + k] * e[k];
       e[i] *= inv_diag[i];
       s += e[i] * e[i];
