@@ -132,19 +132,24 @@ class ContactCloud {
       if (hit) {
         const index::PointId id = hit->id;
         Point& point = points_[id];
-        State fused = point.state;
-        if (policy_.fuse(fused, contact, point.meta.observations)) {
-          const Vec3<Scalar> mean = policy_.mean(fused);
-          if (!all_finite(mean) || !all_finite(policy_.covariance(fused))) {
+        // Fused in place, with a copy to put back when the update overflows (fusing into a
+        // copy and writing it back cost Surfel about 3 % of its instructions per contact).
+        const State before = point.state;
+        if (policy_.fuse(point.state, contact, point.meta.observations)) {
+          const Vec3<Scalar> mean = policy_.mean(point.state);
+          if (!all_finite(mean) || !all_finite(policy_.covariance(point.state))) {
             // Only reachable with extreme magnitudes (overflow); keep the model intact.
+            point.state = before;
             return {InsertStatus::rejected, 0, ContactDefect::overflow};
           }
-          point.state = fused;
           ++point.meta.observations;
           point.meta.last_time = contact.time;
           index_.move(id, mean);
           return {InsertStatus::fused, id, ContactDefect::ok};
         }
+        // A refusing policy leaves the state as it was (FusionPolicy); a user's policy that
+        // does not cannot change the point either.
+        point.state = before;
       }
     }
     TAXEL_ASSERT(points_.size() < std::numeric_limits<index::PointId>::max(),

@@ -75,7 +75,11 @@ struct Kalman {
   /// by its adjugate, the gain is scaled by 1/det last (so the division overlaps the
   /// product), and of the Joseph form only the upper triangle is formed, then mirrored.
   bool fuse(State& s, const Contact<S>& c, std::uint32_t) const {
-    const Mat3<S>& r = c.covariance;
+    return update(s, c.position, c.covariance);
+  }
+  /// The same update from a measured position [m] and its covariance r [m^2] (all that `fuse`
+  /// reads of a contact).
+  bool update(State& s, const Vec3<S>& position, const Mat3<S>& r) const {
     Mat3<S>& pm = s.covariance;
     const S q2 = config_.process_noise * config_.process_noise;
     // Predicted covariance P- (symmetric: the upper triangle is read).
@@ -90,8 +94,8 @@ struct Kalman {
                          {cc * e - b * f, a * f - cc * cc, b * cc - a * e},
                          {b * e - cc * d, b * cc - a * e, a * d - b * b}};
     const S inv_det = S(1) / (a * adj[0][0] + b * adj[0][1] + cc * adj[0][2]);
-    const S v[3] = {c.position.x() - s.mean.x(), c.position.y() - s.mean.y(),
-                    c.position.z() - s.mean.z()};
+    const S v[3] = {position.x() - s.mean.x(), position.y() - s.mean.y(),
+                    position.z() - s.mean.z()};
     if (config_.gate_chi2) {
       S m2 = S(0);
       for (int i = 0; i < 3; ++i) {

@@ -96,6 +96,8 @@ struct Surfel {
                                   std::to_string(config.curvature_prior));
     }
     cos_max_ = std::cos(config.max_normal_angle);
+    ridge_ = config.normal_sigma * config.normal_sigma /
+             (config.curvature_prior * config.curvature_prior);
   }
 
   /// A point at the contact; its frame starts here when the contact has a normal.
@@ -130,13 +132,11 @@ struct Surfel {
         k * v.y() * v.x() + v.z(), diag + k * v.y() * v.y(), k * v.y() * v.z() - v.x(),
         k * v.z() * v.x() - v.y(), k * v.z() * v.y() + v.x(), diag + k * v.z() * v.z();
     const Mat3<S> qc = q * c.covariance;
-    Contact<S> turned = c;
+    Mat3<S> turned;
     for (int i = 0; i < 3; ++i) {
-      for (int j = i; j < 3; ++j) {
-        turned.covariance(i, j) = turned.covariance(j, i) = qc.row(i).dot(q.row(j));
-      }
+      for (int j = i; j < 3; ++j) turned(i, j) = turned(j, i) = qc.row(i).dot(q.row(j));
     }
-    if (!kalman_.fuse(s.kalman, turned, n)) return false;
+    if (!kalman_.update(s.kalman, c.position, turned)) return false;
     // Curvature sums in the frame of the first contact.
     const Vec3<S> t2 = s.n0.cross(s.t1);
     const Vec3<S> d = c.position - s.origin;
@@ -148,7 +148,7 @@ struct Surfel {
     const S inv_nz = S(1) / nz;
     const S sx = s.t1.dot(nc) * inv_nz, sy = t2.dot(nc) * inv_nz;
     // Weighted like the Kalman average along the normal: by the contact's information there.
-    const S w = S(1) / nm.dot(turned.covariance * nm);
+    const S w = S(1) / nm.dot(turned * nm);
     s.normal_sum += nc;
     s.count += S(1);
     add_sums(s, w, share(c), ux, uy, s.n0.dot(d), sx, sy);
@@ -195,8 +195,7 @@ struct Surfel {
     const S ux = s.vu[0] * inv, uy = s.vu[1] * inv, sx = s.ss[0] * inv, sy = s.ss[1] * inv;
     // The ridge against the fit's total slope information: count / normal_sigma^2 when every
     // slope has the default noise, less as stated slopes are noisier (weight / vweight).
-    const S lambda = config_.normal_sigma * config_.normal_sigma /
-                     (config_.curvature_prior * config_.curvature_prior) / s.count * s.weight * inv;
+    const S lambda = ridge_ / s.count * s.weight * inv;
     const S a = s.vuu[0] * inv - ux * ux + lambda, b = s.vuu[1] * inv - ux * uy;
     const S d = s.vuu[2] * inv - uy * uy + lambda;
     const S det = a * d - b * b;
@@ -252,7 +251,8 @@ struct Surfel {
 
   Config config_{};
   Kalman<S> kalman_{};
-  S cos_max_ = S(0.36235775447667357);  // cos(1.2)
+  S cos_max_ = S(0.36235775447667357);               // cos(1.2)
+  S ridge_ = S(0.05) * S(0.05) / (S(100) * S(100));  // (normal_sigma / curvature_prior)^2
 };
 
 }  // namespace taxel::fusion
