@@ -24,11 +24,11 @@ namespace taxel::fusion {
 /// (1 - 2 s_n^2/s_t^2) E[u'Hu]/2: each tight plane is the tangent plane at its own contact,
 /// and tangent planes of a convex patch meet outside it.
 ///
-/// What. The point keeps a tangent frame (normal n0 and origin from its first contact with a
-/// normal) and, for every contact whose normal lies within `max_normal_angle` of the point's
-/// mean normal:
+/// What. The point keeps a Kalman filter on its position, a tangent frame (normal n0 from its
+/// first contact with a normal, origin at its first contact) and, for every contact whose
+/// normal lies within `max_normal_angle` of the point's mean normal:
 ///  - the contact's covariance is turned onto the point's mean normal (Rodrigues rotation
-///    taking the contact normal to it), so all tight planes are parallel and the Kalman mean
+///    taking the contact normal to it), so all tight planes are parallel and the filter's mean
 ///    is an information-weighted average in that frame, whose only bias is the sag;
 ///  - its sideways offset u (in the frame) and its normal's slope s (sideways part over
 ///    normal part, which is H u + const on a quadric) are accumulated, 19 sums in all;
@@ -43,12 +43,19 @@ namespace taxel::fusion {
 ///    offsets), the sag bounded by half the offsets' spread so that a noisy fit cannot throw
 ///    the point off the surface.
 /// Contacts without a normal, or turned further than `max_normal_angle` (across an edge),
-/// update the Kalman state unchanged and do not enter the sums. On a plane with exact normals
-/// (all equal) the rotation is the identity and H = 0: the result is exactly `Kalman`'s.
+/// update the filter unturned and do not enter the sums. On a plane with exact normals (all
+/// equal) the rotation is the identity and H = 0: the result is `Kalman`'s, up to rounding.
 /// The offsets are measured positions: their own noise is not removed from M (the contacts
 /// a point gathers are those whose noisy positions fall near it, a Berkson error model, so
-/// an errors-in-variables correction would overcorrect). State: 352 bytes (double).
-/// No allocation.
+/// an errors-in-variables correction would overcorrect).
+///
+/// The filter is `Kalman`'s (same `Config::kalman`: process noise, gate, P0) kept in
+/// information form, J = P^-1 and eta = J (mu - origin): without process noise or gate an
+/// update is two sums, J += R^-1 and eta += R^-1 (m - origin), and the rotation turns R^-1,
+/// which does not depend on the state. P = J^-1 is formed when asked for (`covariance`), and
+/// in each update only with process noise or a gate. A covariance whose inverse overflows
+/// (a variance below about 1e-308 m^2) makes the point non-finite, and `ContactCloud` refuses
+/// the contact. State: 376 bytes (double). No allocation.
 template <Scalar S>
 struct Surfel {
   using Scalar = S;
@@ -60,13 +67,16 @@ struct Surfel {
     S normal_sigma = S(0.05);    ///< noise of a contact normal [rad], > 0
     S curvature_prior = S(100);  ///< prior standard deviation of the curvature [1/m], > 0
   };
-  /// A fused point: the Kalman state, its tangent frame and the curvature sums.
+  /// A fused point: the filter in information form, its tangent frame and the curvature sums.
   struct State {
-    typename Kalman<S>::State kalman;
-    Vec3<S> origin;      ///< frame origin [m]: the first contact with a normal
-    Vec3<S> n0;          ///< frame normal (zero until a contact with a normal arrives)
-    Vec3<S> t1;          ///< first tangent of the frame; the second is n0 x t1
-    Vec3<S> normal_sum;  ///< sum of the accepted contact normals
+    Vec3<S> origin;  ///< the first contact's position [m]: origin of the filter and the frame
+    S info[6];       ///< filter information J = P^-1 (xx, xy, xz, yy, yz, zz) [1/m^2]
+    Vec3<S> eta;     ///< information vector J (mu - origin), mu the filter mean [1/m]
+    Vec3<S> n0;      ///< frame normal (zero until a contact with a normal arrives)
+    Vec3<S> t1;      ///< first tangent of the frame
+    Vec3<S> t2;      ///< second tangent of the frame, n0 x t1
+    Vec3<S> normal_sum;   ///< sum of the accepted contact normals
+    Vec3<S> unit_normal;  ///< normal_sum / |normal_sum| (zero until a contact with a normal)
     S count;             ///< contacts in the sums
     S weight;            ///< sum of their weights w (information along the normal) [1/m^2]
     S sz;                ///< w-weighted sum of the heights z along n0 [m]
@@ -82,7 +92,8 @@ struct Surfel {
 
   Surfel() = default;
   /// Throws std::invalid_argument naming the field that is out of range.
-  explicit Surfel(const Config& config) : config_(config), kalman_(config.kalman) {
+  explicit Surfel(const Config& config) : config_(config) {
+    (void)Kalman<S>(config.kalman);  // validates the filter's part, naming the field
     if (!(config.max_normal_angle > S(0)) || !(config.max_normal_angle < S(1.5707963267948966))) {
       throw std::invalid_argument("Surfel::Config::max_normal_angle must be in (0, pi/2), got " +
                                   std::to_string(config.max_normal_angle));
@@ -96,6 +107,7 @@ struct Surfel {
                                   std::to_string(config.curvature_prior));
     }
     cos_max_ = std::cos(config.max_normal_angle);
+    q2_ = config.kalman.process_noise * config.kalman.process_noise;
     ridge_ = config.normal_sigma * config.normal_sigma /
              (config.curvature_prior * config.curvature_prior);
   }
@@ -103,27 +115,34 @@ struct Surfel {
   /// A point at the contact; its frame starts here when the contact has a normal.
   State init(const Contact<S>& c) const {
     State s{};
-    s.kalman = kalman_.init(c);
+    s.origin = c.position;
+    if (config_.kalman.initial_sigma) {
+      const S v = S(1) / (*config_.kalman.initial_sigma * *config_.kalman.initial_sigma);
+      s.info[0] = s.info[3] = s.info[5] = v;
+    } else {
+      inverse(c.covariance, s.info);
+    }
     if (c.normal) start_frame(s, c);
     return s;
   }
 
-  /// One update; false (state untouched) when the Kalman gate refuses the contact.
-  bool fuse(State& s, const Contact<S>& c, std::uint32_t n) const {
-    if (!c.normal) return kalman_.fuse(s.kalman, c, n);
+  /// One update; false (state untouched) when the Mahalanobis gate refuses the contact.
+  bool fuse(State& s, const Contact<S>& c, std::uint32_t) const {
+    S ci[6];  // the contact's information R^-1: it does not depend on the state
+    inverse(c.covariance, ci);
+    if (!c.normal) return filter(s, c, ci);
     if (s.count == S(0)) {
-      if (!kalman_.fuse(s.kalman, c, n)) return false;
+      if (!filter(s, c, ci)) return false;
       start_frame(s, c);
       return true;
     }
     const Vec3<S>& nc = *c.normal;
-    // Reciprocals taken once: divisions are a large part of this update's cost.
-    const Vec3<S> nm = s.normal_sum * (S(1) / std::sqrt(s.normal_sum.squaredNorm()));
+    const Vec3<S>& nm = s.unit_normal;
     const S cos_c = nc.dot(nm);
-    if (!(cos_c >= cos_max_)) return kalman_.fuse(s.kalman, c, n);
-    // Turn the covariance onto the mean normal: Q = I + [v]x + [v]x^2 / (1 + c), v = nc x nm,
-    // with [v]x^2 = v v' - |v|^2 I written out, and only the upper triangle of Q C Q' computed
-    // (it is symmetric by construction).
+    if (!(cos_c >= cos_max_)) return filter(s, c, ci);
+    // Turn the information onto the mean normal: Q R^-1 Q' with Q = I + [v]x + [v]x^2 / (1 + c),
+    // v = nc x nm, [v]x^2 = v v' - |v|^2 I written out; only the upper triangle is formed (it
+    // is symmetric by construction).
     const Vec3<S> v = nc.cross(nm);
     const S k = S(1) / (S(1) + cos_c);
     const S diag = S(1) - k * v.squaredNorm();
@@ -131,35 +150,38 @@ struct Surfel {
     q << diag + k * v.x() * v.x(), k * v.x() * v.y() - v.z(), k * v.x() * v.z() + v.y(),
         k * v.y() * v.x() + v.z(), diag + k * v.y() * v.y(), k * v.y() * v.z() - v.x(),
         k * v.z() * v.x() - v.y(), k * v.z() * v.y() + v.x(), diag + k * v.z() * v.z();
-    const Mat3<S> qc = q * c.covariance;
-    Mat3<S> turned;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = i; j < 3; ++j) turned(i, j) = turned(j, i) = qc.row(i).dot(q.row(j));
+    Mat3<S> cm;
+    cm << ci[0], ci[1], ci[2], ci[1], ci[3], ci[4], ci[2], ci[4], ci[5];
+    const Mat3<S> qc = q * cm;
+    S turned[6];
+    for (int i = 0, at = 0; i < 3; ++i) {
+      for (int j = i; j < 3; ++j) turned[at++] = qc.row(i).dot(q.row(j));
     }
-    if (!kalman_.update(s.kalman, c.position, turned)) return false;
+    if (!filter(s, c, turned)) return false;
     // Curvature sums in the frame of the first contact.
-    const Vec3<S> t2 = s.n0.cross(s.t1);
     const Vec3<S> d = c.position - s.origin;
-    const S ux = s.t1.dot(d), uy = t2.dot(d);
+    const S ux = s.t1.dot(d), uy = s.t2.dot(d);
     // A slope is tan of the normal's angle to n0: beyond max_normal_angle it is no curvature
     // datum but an edge or an outlier, and would dominate the fit.
     const S nz = nc.dot(s.n0);
     if (!(nz >= cos_max_)) return true;
     const S inv_nz = S(1) / nz;
-    const S sx = s.t1.dot(nc) * inv_nz, sy = t2.dot(nc) * inv_nz;
-    // Weighted like the Kalman average along the normal: by the contact's information there.
-    const S w = S(1) / nm.dot(turned * nm);
+    const S sx = s.t1.dot(nc) * inv_nz, sy = s.t2.dot(nc) * inv_nz;
+    // Weighted like the filter along the normal, by the contact's information there: the
+    // variance along nm of the turned covariance is nc' R nc.
+    const S w = S(1) / nc.dot(c.covariance * nc);
     s.normal_sum += nc;
+    s.unit_normal = s.normal_sum * (S(1) / std::sqrt(s.normal_sum.squaredNorm()));
     s.count += S(1);
     add_sums(s, w, share(c), ux, uy, s.n0.dot(d), sx, sy);
     return true;
   }
 
   /// The surface point [m]: the point of the quadric fitted to the contacts above their
-  /// weighted centroid in the tangent plane (the Kalman mean until a contact with a normal
+  /// weighted centroid in the tangent plane (`filter_mean` until a contact with a normal
   /// arrives).
   Vec3<S> mean(const State& s) const noexcept {
-    if (s.count < S(1)) return s.kalman.mean;
+    if (s.count < S(1)) return filter_mean(s);
     const S inv = S(1) / s.weight;
     const S ux = s.su[0] * inv, uy = s.su[1] * inv;
     S h[3];
@@ -175,16 +197,27 @@ struct Surfel {
     const S bound2 = S(0.25) * std::max(cxx + cyy, S(0));
     if (!(sag * sag <= bound2)) sag = std::copysign(std::sqrt(bound2), sag);  // rare: no sqrt
     const S z = s.sz * inv + sag;
-    return s.origin + ux * s.t1 + uy * s.n0.cross(s.t1) + z * s.n0;
+    return s.origin + ux * s.t1 + uy * s.t2 + z * s.n0;
   }
   /// The point's surface normal: the mean of its contacts' normals (unit), or zero when no
   /// contact had one.
-  Vec3<S> normal(const State& s) const noexcept {
-    const S n = s.normal_sum.norm();
-    return n > S(0) ? Vec3<S>(s.normal_sum / n) : Vec3<S>::Zero();
+  Vec3<S> normal(const State& s) const noexcept { return s.unit_normal; }
+  /// The filter covariance P = J^-1 [m^2] (the sag term adds no variance).
+  Mat3<S> covariance(const State& s) const noexcept {
+    S p[6];
+    inverse(s.info, p);
+    Mat3<S> m;
+    m << p[0], p[1], p[2], p[1], p[3], p[4], p[2], p[4], p[5];
+    return m;
   }
-  /// The filter covariance [m^2] (of the Kalman state; the sag term adds no variance).
-  const Mat3<S>& covariance(const State& s) const noexcept { return s.kalman.covariance; }
+  /// The filter mean [m]: the Kalman mean of every contact the point absorbed, with the
+  /// covariances of those that entered the sums turned onto the point's normal (`mean` until a
+  /// contact has a normal).
+  Vec3<S> filter_mean(const State& s) const noexcept {
+    S p[6];
+    inverse(s.info, p);
+    return s.origin + times(p, s.eta);
+  }
 
   /// The fitted curvature (H_xx, H_xy, H_yy) [1/m] in the point's tangent frame; zeros with
   /// fewer than three contacts in the sums.
@@ -210,13 +243,72 @@ struct Surfel {
   }
 
  private:
+  // The frame starts at the first contact with a normal (its offset from the origin is
+  // the frame's first datum).
   void start_frame(State& s, const Contact<S>& c) const {
-    s.origin = c.position;
     s.n0 = *c.normal;
     s.t1 = s.n0.unitOrthogonal();
+    s.t2 = s.n0.cross(s.t1);
     s.normal_sum = s.n0;
+    s.unit_normal = s.n0;
     s.count = S(1);
-    add_sums(s, S(1) / s.n0.dot(c.covariance * s.n0), share(c), S(0), S(0), S(0), S(0), S(0));
+    const Vec3<S> d = c.position - s.origin;
+    add_sums(s, S(1) / s.n0.dot(c.covariance * s.n0), share(c), s.t1.dot(d), s.t2.dot(d),
+             s.n0.dot(d), S(0), S(0));
+  }
+  // The filter's update with information ri = R^-1 (upper triangle) of a contact at m: a
+  // Kalman filter with identity models in information form,
+  //   predict (q > 0 only): P- = J^-1 + q^2 I, J- = (P-)^-1, eta- = J- mu;
+  //   update:               J += R^-1, eta += R^-1 (m - origin).
+  // With q = 0 and no gate the update is two sums: no inverse of the state.
+  bool filter(State& s, const Contact<S>& c, const S ri[6]) const {
+    const Vec3<S> d = c.position - s.origin;
+    if (q2_ > S(0) || config_.kalman.gate_chi2) {
+      S p[6];
+      inverse(s.info, p);
+      const Vec3<S> mu = times(p, s.eta);
+      p[0] += q2_;
+      p[3] += q2_;
+      p[5] += q2_;
+      if (config_.kalman.gate_chi2) {
+        // Mahalanobis distance of the innovation under P- + R (R the covariance as fused:
+        // turned when ri is).
+        S r[6], sm[6], si[6];
+        inverse(ri, r);
+        for (int i = 0; i < 6; ++i) sm[i] = p[i] + r[i];
+        inverse(sm, si);
+        const Vec3<S> e = d - mu;
+        if (e.dot(times(si, e)) > *config_.kalman.gate_chi2) return false;
+      }
+      if (q2_ > S(0)) {
+        inverse(p, s.info);
+        s.eta = times(s.info, mu);
+      }
+    }
+    for (int i = 0; i < 6; ++i) s.info[i] += ri[i];
+    s.eta += times(ri, d);
+    return true;
+  }
+  // The inverse of a symmetric positive definite 3x3 matrix (upper triangle, row by row) by
+  // its adjugate.
+  static void inverse(const S m[6], S out[6]) noexcept {
+    const S a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5];
+    const S a00 = d * f - e * e, a01 = c * e - b * f, a02 = b * e - c * d;
+    const S inv_det = S(1) / (a * a00 + b * a01 + c * a02);
+    out[0] = a00 * inv_det;
+    out[1] = a01 * inv_det;
+    out[2] = a02 * inv_det;
+    out[3] = (a * f - c * c) * inv_det;
+    out[4] = (b * c - a * e) * inv_det;
+    out[5] = (a * d - b * b) * inv_det;
+  }
+  static void inverse(const Mat3<S>& m, S out[6]) noexcept {
+    const S u[6] = {m(0, 0), m(0, 1), m(0, 2), m(1, 1), m(1, 2), m(2, 2)};
+    inverse(u, out);
+  }
+  static Vec3<S> times(const S m[6], const Vec3<S>& x) noexcept {
+    return {m[0] * x.x() + m[1] * x.y() + m[2] * x.z(), m[1] * x.x() + m[3] * x.y() + m[4] * x.z(),
+            m[2] * x.x() + m[4] * x.y() + m[5] * x.z()};
   }
   // The weight of a contact's slope in the curvature fit, relative to its height's: 1 for a
   // normal as good as normal_sigma (or one that states no sigma_c), (normal_sigma / sigma_c)^2
@@ -250,7 +342,7 @@ struct Surfel {
   }
 
   Config config_{};
-  Kalman<S> kalman_{};
+  S q2_ = S(0);  // process noise variance q^2 [m^2]
   S cos_max_ = S(0.36235775447667357);               // cos(1.2)
   S ridge_ = S(0.05) * S(0.05) / (S(100) * S(100));  // (normal_sigma / curvature_prior)^2
 };
