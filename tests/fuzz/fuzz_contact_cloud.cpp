@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Fuzzes ContactCloud::insert with arbitrary contacts (any bit patterns, NaN, Inf, huge,
 // indefinite; with a normal or without) and association gates (association_sigmas from the
-// first byte, so huge covariances widen the gate without bound): it must never crash, reject
-// exactly the invalid ones, and keep every fused point finite.
+// first byte, so huge covariances widen the gate without bound), with Surfel's filter plain,
+// with process noise, with a Mahalanobis gate or both (also from the first byte): it must
+// never crash, reject exactly the invalid ones, and keep every fused point finite.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -12,9 +13,14 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const double sigmas = double(data[0] % 16);  // 0 (fixed gate) .. 15
+  taxel::fusion::Kalman<double>::Config filter;
+  if (data[0] & 16) filter.process_noise = 1e-4;
+  if (data[0] & 32) filter.gate_chi2 = taxel::fusion::kChi2Dof3P99;
   ++data;
   --size;
-  taxel::fusion::ContactCloud<> cloud({.association_radius = 2e-3, .association_sigmas = sigmas});
+  taxel::fusion::ContactCloud<> cloud({.association_radius = 2e-3,
+                                       .association_sigmas = sigmas,
+                                       .fusion = {.kalman = filter}});
   // Position, upper triangle of the covariance, normal (used when its first byte is odd).
   constexpr std::size_t kDoubles = 3 + 6 + 3;
   while (size >= kDoubles * sizeof(double)) {
@@ -46,7 +52,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
          cloud.size() != before)) {
       std::abort();
     }
-    if (r.status != taxel::fusion::InsertStatus::rejected && !cloud.mean(r.id).allFinite()) {
+    if (r.status != taxel::fusion::InsertStatus::rejected &&
+        (!cloud.mean(r.id).allFinite() || !cloud.covariance(r.id).allFinite())) {
       std::abort();
     }
   }
