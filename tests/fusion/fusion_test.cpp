@@ -623,6 +623,9 @@ TEST_CASE("Surfel equals Kalman on a plane with exact normals", "[fusion]") {
     }
     // Surfel keeps the filter in information form; Kalman in covariance form (Joseph).
     CHECK((surfel.mean(s0) - kalman.mean(k0)).norm() < 1e-15);
+    CHECK(surfel.mean(s0) == surfel.filter_mean(s0));
+    // No contact had a normal: the point has none (every member of a state starts at zero).
+    CHECK(surfel.normal(s0) == taxel::Vec3d::Zero());
     CHECK((surfel.covariance(s0) - kalman.covariance(k0)).norm() <
           1e-12 * kalman.covariance(k0).norm());
   }

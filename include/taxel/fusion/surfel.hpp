@@ -68,25 +68,31 @@ struct Surfel {
     S curvature_prior = S(100);  ///< prior standard deviation of the curvature [1/m], > 0
   };
   /// A fused point: the filter in information form, its tangent frame and the curvature sums.
+  /// Every member starts at zero (Eigen's vectors would otherwise start uninitialised, even in
+  /// `State s{}`).
   struct State {
-    Vec3<S> origin;  ///< the first contact's position [m]: origin of the filter and the frame
-    S info[6];       ///< filter information J = P^-1 (xx, xy, xz, yy, yz, zz) [1/m^2]
-    Vec3<S> eta;     ///< information vector J (mu - origin), mu the filter mean [1/m]
-    Vec3<S> n0;      ///< frame normal (zero until a contact with a normal arrives)
-    Vec3<S> t1;      ///< first tangent of the frame
-    Vec3<S> t2;      ///< second tangent of the frame, n0 x t1
-    Vec3<S> normal_sum;   ///< sum of the accepted contact normals
-    Vec3<S> unit_normal;  ///< normal_sum / |normal_sum| (zero until a contact with a normal)
-    S count;             ///< contacts in the sums
-    S weight;            ///< sum of their weights w (information along the normal) [1/m^2]
-    S sz;                ///< w-weighted sum of the heights z along n0 [m]
-    S su[2];             ///< w-weighted sum of u [m]
-    S suu[3];            ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
+    Vec3<S> origin = Vec3<S>::Zero();  ///< the first contact's position [m]: origin of the
+                                       ///< filter and the frame
+    S info[6] = {};                    ///< filter information J = P^-1 (xx, xy, xz, yy, yz, zz)
+                                       ///< [1/m^2]
+    Vec3<S> eta = Vec3<S>::Zero();     ///< information vector J (mu - origin), mu the filter
+                                       ///< mean [1/m]
+    Vec3<S> n0 = Vec3<S>::Zero();  ///< frame normal (zero until a contact with a normal arrives)
+    Vec3<S> t1 = Vec3<S>::Zero();  ///< first tangent of the frame
+    Vec3<S> t2 = Vec3<S>::Zero();  ///< second tangent of the frame, n0 x t1
+    Vec3<S> normal_sum = Vec3<S>::Zero();   ///< sum of the accepted contact normals
+    Vec3<S> unit_normal = Vec3<S>::Zero();  ///< normal_sum / |normal_sum| (zero until a
+                                            ///< contact with a normal)
+    S count = S(0);   ///< contacts in the sums
+    S weight = S(0);  ///< sum of their weights w (information along the normal) [1/m^2]
+    S sz = S(0);      ///< w-weighted sum of the heights z along n0 [m]
+    S su[2] = {};     ///< w-weighted sum of u [m]
+    S suu[3] = {};    ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
     // The curvature fit's sums, weighted by v = w k (k <= 1 the slope's share, see share()).
-    S vweight;       ///< sum of v [1/m^2]
-    S vu[2], ss[2];  ///< v-weighted sums of u [m] and s [-]
-    S vuu[3];        ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
-    S ssu[4];        ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
+    S vweight = S(0);         ///< sum of v [1/m^2]
+    S vu[2] = {}, ss[2] = {};  ///< v-weighted sums of u [m] and s [-]
+    S vuu[3] = {};            ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
+    S ssu[4] = {};            ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
   };
   static constexpr bool kMerges = true;
 
