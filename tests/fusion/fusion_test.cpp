@@ -631,7 +631,7 @@ TEST_CASE("Surfel equals Kalman on a plane with exact normals", "[fusion]") {
   }
 }
 
-TEST_CASE("Surfel's filter in information form equals Kalman with process noise and a gate",
+TEST_CASE("Surfel's filter in information form equals Kalman with process noise, gate and P0",
           "[fusion]") {
   // Contacts without a normal reach only the filter, so Surfel's covariance and mean must be
   // those of Kalman (covariance form, Joseph update) on the same stream, refusals included:
@@ -641,9 +641,11 @@ TEST_CASE("Surfel's filter in information form equals Kalman with process noise 
   std::normal_distribution<double> g(0.0, 1.0);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (const double q : {0.0, 2e-5}) {
-    for (const bool gated : {false, true}) {
+    for (const int variant : {0, 1, 2}) {  // no gate; a gate; a gate and P0 = (2 mm)^2 I
+      const bool gated = variant > 0;
       typename tf::Kalman<double>::Config kc{.process_noise = q};
       if (gated) kc.gate_chi2 = tf::kChi2Dof3P95;
+      if (variant == 2) kc.initial_sigma = 2e-3;
       const tf::Kalman<double> kalman(kc);
       const tf::Surfel<double> surfel({.kalman = kc});
       const auto make = [&] {
@@ -663,7 +665,7 @@ TEST_CASE("Surfel's filter in information form equals Kalman with process noise 
         REQUIRE(surfel.fuse(s, c, i) == fk);
         refused += fk ? 0 : 1;
       }
-      CAPTURE(q, gated, refused);
+      CAPTURE(q, variant, refused);
       if (gated) CHECK(refused > 20);  // the gate is exercised
       if (!gated) CHECK(refused == 0);
       CHECK((surfel.mean(s) - kalman.mean(k)).norm() < 1e-12);
