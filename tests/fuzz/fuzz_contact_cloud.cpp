@@ -18,9 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (data[0] & 32) filter.gate_chi2 = taxel::fusion::kChi2Dof3P99;
   ++data;
   --size;
-  taxel::fusion::ContactCloud<> cloud({.association_radius = 2e-3,
-                                       .association_sigmas = sigmas,
-                                       .fusion = {.kalman = filter}});
+  taxel::fusion::ContactCloud<> cloud(
+      {.association_radius = 2e-3, .association_sigmas = sigmas, .fusion = {.kalman = filter}});
   // Position, upper triangle of the covariance, normal (used when its first byte is odd).
   constexpr std::size_t kDoubles = 3 + 6 + 3;
   while (size >= kDoubles * sizeof(double)) {

@@ -83,16 +83,16 @@ struct Surfel {
     Vec3<S> normal_sum = Vec3<S>::Zero();   ///< sum of the accepted contact normals
     Vec3<S> unit_normal = Vec3<S>::Zero();  ///< normal_sum / |normal_sum| (zero until a
                                             ///< contact with a normal)
-    S count = S(0);   ///< contacts in the sums
+    S count = S(0);                         ///< contacts in the sums
     S weight = S(0);  ///< sum of their weights w (information along the normal) [1/m^2]
     S sz = S(0);      ///< w-weighted sum of the heights z along n0 [m]
     S su[2] = {};     ///< w-weighted sum of u [m]
     S suu[3] = {};    ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
     // The curvature fit's sums, weighted by v = w k (k <= 1 the slope's share, see share()).
-    S vweight = S(0);         ///< sum of v [1/m^2]
+    S vweight = S(0);          ///< sum of v [1/m^2]
     S vu[2] = {}, ss[2] = {};  ///< v-weighted sums of u [m] and s [-]
-    S vuu[3] = {};            ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
-    S ssu[4] = {};            ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
+    S vuu[3] = {};             ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
+    S ssu[4] = {};             ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
   };
   static constexpr bool kMerges = true;
 
@@ -136,16 +136,17 @@ struct Surfel {
   bool fuse(State& s, const Contact<S>& c, std::uint32_t) const {
     S ci[6];  // the contact's information R^-1: it does not depend on the state
     inverse(c.covariance, ci);
-    if (!c.normal) return filter(s, c, ci);
+    const Vec3<S> d = c.position - s.origin;  // the offset from the point's origin
+    if (!c.normal) return filter(s, d, ci);
     if (s.count == S(0)) {
-      if (!filter(s, c, ci)) return false;
+      if (!filter(s, d, ci)) return false;
       start_frame(s, c);
       return true;
     }
     const Vec3<S>& nc = *c.normal;
     const Vec3<S>& nm = s.unit_normal;
     const S cos_c = nc.dot(nm);
-    if (!(cos_c >= cos_max_)) return filter(s, c, ci);
+    if (!(cos_c >= cos_max_)) return filter(s, d, ci);
     // Turn the information onto the mean normal: Q R^-1 Q' with Q = I + [v]x + [v]x^2 / (1 + c),
     // v = nc x nm, [v]x^2 = v v' - |v|^2 I written out; only the upper triangle is formed (it
     // is symmetric by construction).
@@ -156,16 +157,13 @@ struct Surfel {
     q << diag + k * v.x() * v.x(), k * v.x() * v.y() - v.z(), k * v.x() * v.z() + v.y(),
         k * v.y() * v.x() + v.z(), diag + k * v.y() * v.y(), k * v.y() * v.z() - v.x(),
         k * v.z() * v.x() - v.y(), k * v.z() * v.y() + v.x(), diag + k * v.z() * v.z();
-    Mat3<S> cm;
-    cm << ci[0], ci[1], ci[2], ci[1], ci[3], ci[4], ci[2], ci[4], ci[5];
-    const Mat3<S> qc = q * cm;
+    const Mat3<S> qc = q * symmetric(ci);
     S turned[6];
     for (int i = 0, at = 0; i < 3; ++i) {
       for (int j = i; j < 3; ++j) turned[at++] = qc.row(i).dot(q.row(j));
     }
-    if (!filter(s, c, turned)) return false;
+    if (!filter(s, d, turned)) return false;
     // Curvature sums in the frame of the first contact.
-    const Vec3<S> d = c.position - s.origin;
     const S ux = s.t1.dot(d), uy = s.t2.dot(d);
     // A slope is tan of the normal's angle to n0: beyond max_normal_angle it is no curvature
     // datum but an edge or an outlier, and would dominate the fit.
@@ -212,9 +210,7 @@ struct Surfel {
   Mat3<S> covariance(const State& s) const noexcept {
     S p[6];
     inverse(s.info, p);
-    Mat3<S> m;
-    m << p[0], p[1], p[2], p[1], p[3], p[4], p[2], p[4], p[5];
-    return m;
+    return symmetric(p);
   }
   /// The filter mean [m]: the Kalman mean of every contact the point absorbed, with the
   /// covariances of those that entered the sums turned onto the point's normal (`mean` until a
@@ -262,13 +258,12 @@ struct Surfel {
     add_sums(s, S(1) / s.n0.dot(c.covariance * s.n0), share(c), s.t1.dot(d), s.t2.dot(d),
              s.n0.dot(d), S(0), S(0));
   }
-  // The filter's update with information ri = R^-1 (upper triangle) of a contact at m: a
-  // Kalman filter with identity models in information form,
+  // The filter's update with the information ri = R^-1 (upper triangle) of a contact at
+  // offset d = m - origin: a Kalman filter with identity models in information form,
   //   predict (q > 0 only): P- = J^-1 + q^2 I, J- = (P-)^-1, eta- = J- mu;
   //   update:               J += R^-1, eta += R^-1 (m - origin).
   // With q = 0 and no gate the update is two sums: no inverse of the state.
-  bool filter(State& s, const Contact<S>& c, const S ri[6]) const {
-    const Vec3<S> d = c.position - s.origin;
+  bool filter(State& s, const Vec3<S>& d, const S ri[6]) const {
     if (q2_ > S(0) || config_.kalman.gate_chi2) {
       S p[6];
       inverse(s.info, p);
@@ -312,6 +307,11 @@ struct Surfel {
     const S u[6] = {m(0, 0), m(0, 1), m(0, 2), m(1, 1), m(1, 2), m(2, 2)};
     inverse(u, out);
   }
+  static Mat3<S> symmetric(const S m[6]) noexcept {
+    Mat3<S> out;
+    out << m[0], m[1], m[2], m[1], m[3], m[4], m[2], m[4], m[5];
+    return out;
+  }
   static Vec3<S> times(const S m[6], const Vec3<S>& x) noexcept {
     return {m[0] * x.x() + m[1] * x.y() + m[2] * x.z(), m[1] * x.x() + m[3] * x.y() + m[4] * x.z(),
             m[2] * x.x() + m[4] * x.y() + m[5] * x.z()};
@@ -348,7 +348,7 @@ struct Surfel {
   }
 
   Config config_{};
-  S q2_ = S(0);  // process noise variance q^2 [m^2]
+  S q2_ = S(0);                                      // process noise variance q^2 [m^2]
   S cos_max_ = S(0.36235775447667357);               // cos(1.2)
   S ridge_ = S(0.05) * S(0.05) / (S(100) * S(100));  // (normal_sigma / curvature_prior)^2
 };
