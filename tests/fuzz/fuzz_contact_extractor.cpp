@@ -4,7 +4,8 @@
 // (two bytes a tactel, any value, saturated and above the levels included). Every frame goes
 // through one extractor, which keeps its workspace from frame to frame, and through a new one:
 // the contacts must be the same bits, and every contact valid (finite, symmetric positive
-// definite covariance, unit normal). Nothing may throw: the readings always fit the pad.
+// definite covariance, unit normal); per tactel, there must be one contact per active tactel.
+// Nothing may throw: the readings always fit the pad.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -34,14 +35,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<taxel::Contact<double>> a, b;
   for (std::size_t at = 6; at + 2 * tactels <= size; at += 2 * tactels) {
     tsn::PadMatrix counts(m.geometry.rows, m.geometry.cols);
+    std::size_t active = 0;
     for (std::size_t i = 0; i < tactels; ++i) {
       // Values spread over the levels, with 0, the threshold and saturation common.
       const unsigned v = data[at + 2 * i] | data[at + 2 * i + 1] << 8;
       counts.data()[i] = static_cast<std::uint16_t>(v % (m.levels + 2));
+      active += counts.data()[i] >= m.threshold && counts.data()[i] < m.levels - 1;
     }
     a.clear();
     b.clear();
     const std::size_t n = reused.extract(counts, pose, 0.0, a);
+    // Per tactel, one contact per active tactel (threshold <= k < levels - 1).
+    if (opt.mode == tsn::ContactMode::per_tactel && n != active) std::abort();
     tsn::ContactExtractor fresh(m, opt);
     if (fresh.extract(counts, pose, 0.0, b) != n || a.size() != n || b.size() != n) std::abort();
     for (std::size_t i = 0; i < n; ++i) {

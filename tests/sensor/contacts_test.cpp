@@ -3,12 +3,15 @@
 // plane, sphere and cylinder patches, the censoring bias, the orientation of the covariance, the
 // per-pad quadric contact, and bad input.
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 #include <taxel/sensor.hpp>
 #include <taxel/sim/exploration.hpp>
 #include <taxel/sim/shapes.hpp>
+#include <tuple>
 
 namespace tsn = taxel::sensor;
 using taxel::Vec3d;
@@ -588,4 +591,49 @@ TEST_CASE("readings to contacts: an extractor reused over frames gives what a ne
     }
   }
   CHECK(touching > 100);
+}
+
+TEST_CASE("readings to contacts: the active tactels are those with threshold <= k < levels - 1",
+          "[sensor]") {
+  // The readings are scanned eight at a time where the target has SSE2; the oracle here is the
+  // definition, one reading at a time. Readings over the whole 16-bit range (0, the threshold,
+  // saturation and values above the levels and above 32767 included), pads whose tactel count
+  // is not a multiple of eight, thresholds and levels at their bounds. Per tactel without local
+  // normals or the censoring correction, a contact's pad x and y give its tactel back.
+  std::mt19937 rng(7);
+  using Case = std::tuple<int, int, int, int>;  // rows, cols, levels, threshold
+  for (const auto& [rows, cols, levels, threshold] : std::array<Case, 7>{
+           Case{14, 6, 4096, 8}, Case{13, 7, 4096, 1}, Case{3, 3, 65536, 65535}, Case{16, 16, 2, 1},
+           Case{1, 1, 300, 299}, Case{5, 17, 40000, 35000}, Case{2, 4, 65536, 1}}) {
+    tsn::SensorModel m = noiseless();
+    m.geometry.rows = rows;
+    m.geometry.cols = cols;
+    m.levels = levels;
+    m.threshold = threshold;
+    tsn::ContactExtractor ex(
+        m, {.local_normals = false, .correct_censoring = false, .refine_censoring = false});
+    std::uniform_int_distribution<int> any(0, 65535), jitter(-2, 2);
+    for (int frame = 0; frame < 200; ++frame) {
+      tsn::PadMatrix counts(rows, cols);
+      std::vector<int> expected;
+      for (int i = 0; i < rows * cols; ++i) {
+        // Half the readings within two counts of the threshold or of saturation.
+        int k = any(rng);
+        if (k % 4 == 1) k = threshold + jitter(rng);
+        if (k % 4 == 2) k = levels - 1 + jitter(rng);
+        k = std::clamp(k, 0, 65535);
+        counts.data()[i] = static_cast<std::uint16_t>(k);
+        if (k >= threshold && k < levels - 1) expected.push_back(i);
+      }
+      std::vector<taxel::Contact<double>> out;
+      REQUIRE(ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out) == expected.size());
+      REQUIRE(out.size() == expected.size());
+      for (std::size_t j = 0; j < out.size(); ++j) {
+        const int i = expected[j];
+        const Vec3d at = m.geometry.tactel(i / cols, i % cols);
+        REQUIRE(std::abs(out[j].position.x() - at.x()) < 1e-12);
+        REQUIRE(std::abs(out[j].position.y() - at.y()) < 1e-12);
+      }
+    }
+  }
 }

@@ -83,6 +83,9 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "taxel/core/contact.hpp"
 #include "taxel/core/types.hpp"
@@ -135,6 +138,8 @@ class ContactExtractor {
     const double dq = model_.depth_per_count();
     // Selection is round(measured / dq) >= threshold, i.e. measured >= (threshold - 1/2) dq.
     const double t = (model_.threshold - 0.5) * dq;
+    censor_depth_ = t;
+    inv_sigma_ = model_.sigma_normal > 0 ? 1.0 / model_.sigma_normal : 0.0;
     const int saturated = model_.levels - 1;
     bias_.assign(static_cast<std::size_t>(saturated), 0.0);
     if (options_.correct_censoring) {
@@ -147,7 +152,7 @@ class ContactExtractor {
     const std::size_t tactels =
         static_cast<std::size_t>(model_.geometry.rows) * model_.geometry.cols;
     active_.resize(tactels);
-    listed_.resize(tactels);
+    listed_.resize(tactels + 8);
     cell_.resize(tactels);
     for (std::size_t i = 0; i < tactels; ++i) {
       const std::size_t cols = static_cast<std::size_t>(model_.geometry.cols);
@@ -178,6 +183,11 @@ class ContactExtractor {
       const double l1 = lam * (lam - a);
       lambda_[i][0] = lam;
       lambda_[i][1] = l1 * (lam - a) + lam * (l1 - 1.0);
+    }
+    // Each entry's differences to the next, so that an interpolation reads one entry.
+    for (int i = 0; i + 1 < kTable; ++i) {
+      lambda_[i][2] = lambda_[i + 1][0] - lambda_[i][0];
+      lambda_[i][3] = lambda_[i + 1][1] - lambda_[i][1];
     }
   }
 
@@ -211,21 +221,50 @@ class ContactExtractor {
     const double vd = depth_variance();
     const std::uint16_t* reading = counts.data();
     const std::size_t tactels = static_cast<std::size_t>(g.rows) * g.cols;
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < tactels; ++i) {
-      const int k = reading[i];
-      listed_[n] = static_cast<std::uint32_t>(i);
-      n += (k >= model_.threshold) & (k < saturated);
+    // (Active means threshold <= k < saturated, one unsigned comparison of k - threshold; the
+    // bounds are held in locals, since the stores to listed_ may alias model_.)
+    const unsigned threshold = static_cast<unsigned>(model_.threshold),
+                   span = static_cast<unsigned>(saturated - model_.threshold);
+    std::uint32_t* listed = listed_.data();
+    std::size_t n = 0, i = 0;
+#if defined(__SSE2__)
+    // Eight readings at a time: the unsigned comparison as a signed one of the values with
+    // their sign bits flipped, the active lanes as a byte mask, and their indices from a
+    // table of the 256 masks (listed_ has room for the eight written past the last).
+    {
+      const __m128i zero = _mm_setzero_si128(), lo = _mm_set1_epi16(static_cast<short>(threshold));
+      const __m128i flip = _mm_set1_epi16(static_cast<short>(-32768));
+      const __m128i hi = _mm_set1_epi16(static_cast<short>(static_cast<int>(span) - 32768));
+      const auto& lanes = active_lanes();
+      for (; i + 8 <= tactels; i += 8) {
+        const __m128i k = _mm_loadu_si128(reinterpret_cast<const __m128i*>(reading + i));
+        const __m128i on = _mm_cmplt_epi16(_mm_xor_si128(_mm_sub_epi16(k, lo), flip), hi);
+        const auto mask = static_cast<unsigned>(_mm_movemask_epi8(_mm_packs_epi16(on, zero)));
+        const Lanes& l = lanes[mask];
+        const __m128i at16 =
+            _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(l.index)), zero);
+        const __m128i base = _mm_set1_epi32(static_cast<int>(i));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(listed + n),
+                         _mm_add_epi32(_mm_unpacklo_epi16(at16, zero), base));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(listed + n + 4),
+                         _mm_add_epi32(_mm_unpackhi_epi16(at16, zero), base));
+        n += l.count;
+      }
+    }
+#endif
+    for (; i < tactels; ++i) {
+      listed[n] = static_cast<std::uint32_t>(i);
+      n += (reading[i] - threshold) < span;
     }
     for (std::size_t j = 0; j < n; ++j) {
-      const std::size_t i = listed_[j];
-      const int k = reading[i];
-      const std::size_t at = cell_[i];
+      const std::size_t t = listed[j];
+      const int k = reading[t];
+      const std::size_t at = cell_[t];
       const double b = bias_[static_cast<std::size_t>(k)];
       const double m = k * dq;
       padded_[at] = m - b;
       on_[at] = 1;
-      active_[j] = {at, i, monomials_[i][1], monomials_[i][2], m, 0.0, vd + b * b, b, double(k)};
+      active_[j] = {at, t, monomials_[t][1], monomials_[t][2], m, 0.0, vd + b * b, b, double(k)};
     }
     active_count_ = n;
     factored_ = false;
@@ -243,6 +282,15 @@ class ContactExtractor {
   const ContactOptions& options() const noexcept { return options_; }
 
  private:
+  // An active tactel: its cell in the padded grid, its index, pad coordinates (pitch units from
+  // the pad centre; monomials_ has them too, kept here beside the rest of what the loops read),
+  // measured depth [m], Jensen factor h v / (2 sigma) of the refined correction [m], corrected
+  // depth's variance [m^2] (read by the per-pad contact), plug-in correction [m] and reading.
+  struct Active {
+    std::size_t at, tactel;
+    double x, y, measured, jensen, var, plug_in, pressure;
+  };
+
   double depth_variance() const {
     const double dq = model_.depth_per_count();
     return model_.sigma_normal * model_.sigma_normal + dq * dq / 12.0;
@@ -277,8 +325,7 @@ class ContactExtractor {
     Mat3d cov;
     cov << vt + dv * n.x() * n.x(), cxy, cxz, cxy, vt + dv * n.y() * n.y(), cyz, cxz, cyz,
         vt + dv * n.z() * n.z();
-    out.push_back(
-        Contact<double>{T * Vec3d(x, y, -depth), cov, n, pressure, time, std::sqrt(slope_var)});
+    out.emplace_back(T * Vec3d(x, y, -depth), cov, n, pressure, time, std::sqrt(slope_var));
   }
 
   template <class = void>
@@ -296,17 +343,24 @@ class ContactExtractor {
     const double threshold_bias = at_threshold < bias_.size() ? bias_[at_threshold] : 0.0;
     const double var_depth = refined_ ? vd : vd + threshold_bias * threshold_bias;
     const SharedNoise sn = shared_noise();
+    // The refined censoring's quadric, its slope variances and the censoring constants, in
+    // locals (see Censoring).
+    const Censoring cens = censoring();
+    double q[6], f[6];
+    std::copy(quad_, quad_ + 6, q);
+    std::copy(slope_var_, slope_var_ + 6, f);
     for (std::size_t i = 0; i < active_count_; ++i) {
       const Active& e = active_[i];
-      double gx = 0, gy = 0, vgx = 0, vgy = 0;  // slopes of d per metre and their variances
-      if (options_.local_normals && quad_ok_) {
-        // The pad-wide quadric's gradient at the tactel and its least-squares variances.
+      double gx = 0, gy = 0, vg = 0;  // slopes of d per metre, the sum of their variances
+      double depth = padded_[e.at];
+      if (quad_ok_) {
+        // The pad-wide quadric's gradient at the tactel and its least-squares variances, and
+        // the depth corrected at the quadric's (refine_censoring's last pass).
         const double x = e.x, y = e.y;
-        const double* f = slope_var_;
-        gx = (quad_[1] + 2 * quad_[3] * x + quad_[4] * y) * inv_p;
-        gy = (quad_[2] + quad_[4] * x + 2 * quad_[5] * y) * inv_p;
-        vgx = f[0] + x * (f[1] + f[3] * x + f[4] * y) + y * (f[2] + f[5] * y);
-        vgy = f[6] + x * (f[7] + f[9] * x + f[10] * y) + y * (f[8] + f[11] * y);
+        gx = (q[1] + 2 * q[3] * x + q[4] * y) * inv_p;
+        gy = (q[2] + q[4] * x + 2 * q[5] * y) * inv_p;
+        vg = f[0] + x * (f[1] + f[3] * x + f[4] * y) + y * (f[2] + f[5] * y);
+        depth = refined(cens, e, fitted(q, e)).depth;
       } else if (options_.local_normals) {
         // Least-squares plane over the active 3x3 neighbourhood: linear in the depths, with
         // weights that depend only on which neighbours are active (plane_weights).
@@ -325,16 +379,43 @@ class ContactExtractor {
         const double sum_y = (v[0] + v[1] + v[2]) - (u[0] + u[1] + u[2]);
         gx = (w.x[0] * sum_x + w.x[1] * sum_y + w.x[2] * sum) * inv_p;
         gy = (w.y[0] * sum_x + w.y[1] * sum_y + w.y[2] * sum) * inv_p;
-        vgx = w.fx < 0 ? fb2 : vd * w.fx * inv_p2;
-        vgy = w.fy < 0 ? fb2 : vd * w.fy * inv_p2;
+        vg = (w.fx < 0 ? fb2 : vd * w.fx * inv_p2) + (w.fy < 0 ? fb2 : vd * w.fy * inv_p2);
       }
       // The outward normal -(gx, gy, 1) / |(gx, gy, 1)|, with one division.
       const double scale = -1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
       const Vec3d n_pad(gx * scale, gy * scale, scale);
-      make(out, T, sn, e.x * p, e.y * p, padded_[e.at], n_pad, var_depth, vgx + vgy, e.pressure,
-           time);
+      make(out, T, sn, e.x * p, e.y * p, depth, n_pad, var_depth, vg, e.pressure, time);
     }
     return active_count_;
+  }
+
+  // The refined correction of an active tactel's depth at fitted depth f (the model above,
+  // step 1): d = measured - sigma lambda(a) + jensen lambda''(a), a = (t - f) / sigma, by
+  // linear interpolation in the tables (a clamped to their range; f itself is not clamped at
+  // 0: the fit's noise is symmetric, a clamp would bias it). Also returns a and lambda(a).
+  // (What it reads is copied into a Censoring first, so that the loops calling it keep it in
+  // registers: their stores of doubles could otherwise alias the members.)
+  struct Refined {
+    double depth, a, lambda;
+  };
+  struct Censoring {
+    double t, inv_sigma, sigma;
+    const double (*table)[4];
+  };
+  Censoring censoring() const { return {censor_depth_, inv_sigma_, model_.sigma_normal, lambda_}; }
+  static Refined refined(const Censoring& c, const Active& e, double f) {
+    const double a = (c.t - f) * c.inv_sigma;
+    const double u = std::clamp((a - kTableLow) * kTableScale, 0.0, double(kTable - 1) - 1e-9);
+    const int k = static_cast<int>(u);
+    const double w = u - k;
+    const double* row = c.table[k];
+    const double lam = row[0] + w * row[2];
+    const double l2 = row[1] + w * row[3];
+    return {e.measured - c.sigma * lam + e.jensen * l2, a, lam};
+  }
+  // The refined censoring's quadric (coefficients q in pitch units) at an active tactel.
+  static double fitted(const double* q, const Active& e) {
+    return q[0] + e.x * (q[1] + q[3] * e.x + q[4] * e.y) + e.y * (q[2] + q[5] * e.y);
   }
 
   // The refined censoring correction (the model above, step 1): quadric fit of the plug-in
@@ -343,11 +424,9 @@ class ContactExtractor {
   // determined or it does not fit.
   template <class = void>
   void refine_censoring() {
-    const double dq = model_.depth_per_count();
     const double sigma = model_.sigma_normal;
     const std::size_t count = active_count_;
     if (!(sigma > 0) || count < 7) return;
-    const double t = (model_.threshold - 0.5) * dq;
     // Pass 0's normal equations, on the plug-in depths: the moments of the active tactels'
     // coordinates, and the right-hand side.
     double* ata = factor_;  // factored in place, kept for per_pad
@@ -360,27 +439,18 @@ class ContactExtractor {
     factored_ = true;
     detail_solve(ata, inv_diag, sol);
     const double vd = depth_variance();
-    const double half_v_over_sigma = 0.5 * vd / sigma, inv_sigma = 1.0 / sigma;
-    // The correction at fitted depth f: d = measured - sigma lambda(a) + jensen lambda''(a),
-    // a = (t - f) / sigma, by linear interpolation in the tables (a clamped to their range; f
-    // itself is not clamped at 0: the fit's noise is symmetric, a clamp would bias it), and,
-    // when `with_variance`, the variance of the corrected depth: the truncated normal's,
-    // sigma^2 (1 - lambda'), plus the fit's share through the correction's slope lambda'.
+    const double half_v_over_sigma = 0.5 * vd / sigma;
+    // The corrected depth at fitted depth f (see refined()) and, when `with_variance`, its
+    // variance: the truncated normal's, sigma^2 (1 - lambda'), plus the fit's share through
+    // the correction's slope lambda'.
+    const Censoring cens = censoring();
     const auto correct = [&](Active& e, double f, bool with_variance) {
-      const double a = (t - f) * inv_sigma;
-      const double u = std::clamp((a - kTableLow) * kTableScale, 0.0, double(kTable - 1) - 1e-9);
-      const int k = static_cast<int>(u);
-      const double w = u - k;
-      const double lam = lambda_[k][0] + w * (lambda_[k + 1][0] - lambda_[k][0]);
-      const double l2 = lambda_[k][1] + w * (lambda_[k + 1][1] - lambda_[k][1]);
-      padded_[e.at] = e.measured - sigma * lam + e.jensen * l2;
+      const Refined r = refined(cens, e, f);
+      padded_[e.at] = r.depth;
       if (with_variance) {
-        const double l1 = lam * (lam - a);
+        const double l1 = r.lambda * (r.lambda - r.a);
         e.var = vd * (1.0 - l1) + l1 * l1 * e.jensen * 2.0 * sigma;
       }
-    };
-    const auto fitted = [](const double* q, const Active& e) {
-      return q[0] + e.x * (q[1] + q[3] * e.x + q[4] * e.y) + e.y * (q[2] + q[5] * e.y);
     };
     // The leverages r' A^-1 r (r = 1, X, Y, X^2, XY, Y^2) as one quartic in the pad
     // coordinates, whose 15 coefficients (from the entries of A^-1) are dotted with each
@@ -434,16 +504,21 @@ class ContactExtractor {
     double sol1[6];
     Vec6::Map(sol1) = sum1;
     detail_solve(ata, inv_diag, sol1);
-    // (Only the per-pad contact reads the corrected depths' variances; see the model, step 1.)
-    const bool variances = options_.mode == ContactMode::per_pad;
-    for (std::size_t i = 0; i < count; ++i) {
-      correct(active_[i], fitted(sol1, active_[i]), variances);
-    }
     // The refit gives the per-tactel normals: its gradient at (X, Y) is
     // (q1 + 2 q3 X + q4 Y, q2 + q4 X + 2 q5 Y) per pitch, with variances v e' A^-1 e for
     // e = (0, 1, 0, 2X, Y, 0) and (0, 0, 1, 0, X, 2Y): two quadratic forms in X and Y, whose
-    // coefficients come from the entries of A^-1 (above), scaled to slopes per metre.
-    if (options_.mode != ContactMode::per_tactel || !options_.local_normals) return;
+    // coefficients come from the entries of A^-1 (above), scaled to slopes per metre (only
+    // their sum is used). per_tactel then evaluates the corrections at the refit itself, in
+    // the same pass as the normals.
+    if (options_.mode != ContactMode::per_tactel || !options_.local_normals) {
+      // (Only the per-pad contact reads the corrected depths' variances; see the model,
+      // step 1.)
+      const bool variances = options_.mode == ContactMode::per_pad;
+      for (std::size_t i = 0; i < count; ++i) {
+        correct(active_[i], fitted(sol1, active_[i]), variances);
+      }
+      return;
+    }
     for (int a = 0; a < 6; ++a) quad_[a] = sol1[a];
     const auto inv = [&](int i, int j) { return i >= j ? bb(i, j) : bb(j, i); };
     const double scale = vd / (model_.geometry.pitch * model_.geometry.pitch);
@@ -451,10 +526,7 @@ class ContactExtractor {
                           4 * inv(3, 3), 4 * inv(3, 4), inv(4, 4)};
     const double fy[6] = {inv(2, 2), 2 * inv(2, 4), 4 * inv(2, 5),
                           inv(4, 4), 4 * inv(4, 5), 4 * inv(5, 5)};
-    for (int a = 0; a < 6; ++a) {
-      slope_var_[a] = scale * fx[a];
-      slope_var_[6 + a] = scale * fy[a];
-    }
+    for (int a = 0; a < 6; ++a) slope_var_[a] = scale * (fx[a] + fy[a]);
     quad_ok_ = true;
   }
 
@@ -641,14 +713,9 @@ class ContactExtractor {
   SensorModel model_;
   ContactOptions options_;
   std::vector<double> bias_;  // truncation bias by reading count [m]
-  // An active tactel: its cell in the padded grid, its index, pad coordinates (pitch units from
-  // the pad centre; monomials_ has them too, kept here beside the rest of what the loops read),
-  // measured depth [m], Jensen factor h v / (2 sigma) of the refined correction [m], corrected
-  // depth's variance [m^2] (read by the per-pad contact), plug-in correction [m] and reading.
-  struct Active {
-    std::size_t at, tactel;
-    double x, y, measured, jensen, var, plug_in, pressure;
-  };
+  // The depth [m] at which readings are censored (the threshold count less half a count), and
+  // 1 / sigma_normal [1/m] (0 for a noiseless pad, which is not corrected).
+  double censor_depth_ = 0.0, inv_sigma_ = 0.0;
   // Per tactel: 1, X, Y, X^2, XY, Y^2, X^3, X^2 Y, X Y^2, Y^3, X^4, X^3 Y, X^2 Y^2, X Y^3, Y^4
   // (X, Y its pad coordinates in pitch units) and a zero: the normal matrix of a quadric fit is
   // a sum of these.
@@ -662,9 +729,10 @@ class ContactExtractor {
   double factor_[36] = {}, factor_inv_diag_[6] = {};
   bool factored_ = false;
   // The refined censoring's quadric (coefficients of 1, X, Y, X^2, XY, Y^2 in pitch units),
-  // when it fitted this frame (quad_ok_), and its slope variances as two quadratic forms in
-  // X and Y (coefficients of 1, X, Y, X^2, XY, Y^2; per_tactel).
-  double quad_[6] = {}, slope_var_[12] = {};
+  // when it fitted this frame (quad_ok_: the per-tactel contacts then take their corrected
+  // depths and normals from it), and the sum of its two slope variances as a quadratic form
+  // in X and Y (coefficients of 1, X, Y, X^2, XY, Y^2).
+  double quad_[6] = {}, slope_var_[6] = {};
   bool quad_ok_ = false;
   bool refined_ = false;  // the refined censoring correction applied to this frame
   // The corrected depths [m] (0 where inactive) and active flags of the pad with a border of
@@ -730,10 +798,28 @@ class ContactExtractor {
     }();
     return table;
   }
-  // lambda and lambda'' tabulated at a = kTableLow + i / kTableScale.
+  // For each mask of eight lanes, the indices of its set lanes in order, and their count.
+  struct Lanes {
+    std::uint8_t index[8];
+    std::uint8_t count;
+  };
+  static const std::array<Lanes, 256>& active_lanes() {
+    static constexpr std::array<Lanes, 256> table = [] {
+      std::array<Lanes, 256> t{};
+      for (unsigned mask = 0; mask < 256; ++mask) {
+        for (std::uint8_t lane = 0; lane < 8; ++lane) {
+          if (mask >> lane & 1u) t[mask].index[t[mask].count++] = lane;
+        }
+      }
+      return t;
+    }();
+    return table;
+  }
+  // lambda and lambda'' tabulated at a = kTableLow + i / kTableScale, and their differences
+  // to the next entry (zero at the last).
   static constexpr int kTable = 641;  // a in [-12, 8]
   static constexpr double kTableLow = -12.0, kTableScale = 32.0;
-  double lambda_[kTable][2] = {};
+  alignas(32) double lambda_[kTable][4] = {};
 };
 
 }  // namespace taxel::sensor
