@@ -325,7 +325,8 @@ class ContactExtractor {
     Mat3d cov;
     cov << vt + dv * n.x() * n.x(), cxy, cxz, cxy, vt + dv * n.y() * n.y(), cyz, cxz, cyz,
         vt + dv * n.z() * n.z();
-    out.emplace_back(T * Vec3d(x, y, -depth), cov, n, pressure, time, std::sqrt(slope_var));
+    out.push_back(
+        Contact<double>{T * Vec3d(x, y, -depth), cov, n, pressure, time, std::sqrt(slope_var)});
   }
 
   template <class = void>
