@@ -344,12 +344,9 @@ class ContactExtractor {
     const double threshold_bias = at_threshold < bias_.size() ? bias_[at_threshold] : 0.0;
     const double var_depth = refined_ ? vd : vd + threshold_bias * threshold_bias;
     const SharedNoise sn = shared_noise();
-    // The refined censoring's quadric, its slope variances and the censoring constants, in
-    // locals (see Censoring).
     const Censoring cens = censoring();
-    double q[6], f[6];
-    std::copy(quad_, quad_ + 6, q);
-    std::copy(slope_var_, slope_var_ + 6, f);
+    const double* q = quad_;
+    const double* f = slope_var_;
     for (std::size_t i = 0; i < active_count_; ++i) {
       const Active& e = active_[i];
       double gx = 0, gy = 0, vg = 0;  // slopes of d per metre, the sum of their variances
@@ -394,8 +391,7 @@ class ContactExtractor {
   // step 1): d = measured - sigma lambda(a) + jensen lambda''(a), a = (t - f) / sigma, by
   // linear interpolation in the tables (a clamped to their range; f itself is not clamped at
   // 0: the fit's noise is symmetric, a clamp would bias it). Also returns a and lambda(a).
-  // (What it reads is copied into a Censoring first, so that the loops calling it keep it in
-  // registers: their stores of doubles could otherwise alias the members.)
+  // What it reads of the extractor is gathered once per frame into a Censoring.
   struct Refined {
     double depth, a, lambda;
   };
