@@ -41,6 +41,10 @@ struct Row {
   // The points of 20-99 contacts and of 100 or more, and how many.
   sim::SurfaceError mid, many;
   std::size_t mid_points = 0, many_points = 0;
+  // The angle [rad] between each point's normal (when the policy gives normals) and the true
+  // surface normal at the point, over the points of at least 5 contacts: median and 90th
+  // percentile.
+  double normal_median = 0, normal_p90 = 0;
   double ns_per_contact = 0.0;
   std::vector<double> errors;  // signed distance of every point [m], by id (`keep_errors`)
 };
@@ -76,6 +80,19 @@ Row fuse(const Shape& shape, const std::vector<Contact<double>>& contacts, std::
   r.supported = sim::surface_error(
       shape, cloud.to_point_cloud({3, std::numeric_limits<double>::infinity(), 0.3e-3}).points);
   r.confirmed_points = confirmed.size();
+  if (!pc.normals.empty()) {
+    std::vector<double> angles;
+    for (std::size_t i = 0; i < pc.size(); ++i) {
+      if (pc.field("observations")->values[i] < 5) continue;
+      const double c = shape.normal(pc.points[i]).dot(pc.normals[i]);
+      angles.push_back(std::acos(std::clamp(c, -1.0, 1.0)));
+    }
+    if (!angles.empty()) {
+      std::sort(angles.begin(), angles.end());
+      r.normal_median = angles[angles.size() / 2];
+      r.normal_p90 = angles[(angles.size() * 9) / 10];
+    }
+  }
   if (keep_errors) {
     for (const Vec3d& x : pc.points) r.errors.push_back(shape.signed_distance(x));
   }
@@ -275,6 +292,7 @@ struct PadLine {
   int seed = 0;
   DepthBands bands;     // the raw contacts by true depth (per tactel only)
   std::string support;  // averaging and Surfel over the points of 20-99 and 100+ contacts
+  double normal_median = 0, normal_p90 = 0;  // Surfel's point normals [rad] (Row)
 };
 
 template <class Shape>
@@ -322,6 +340,8 @@ PadLine pad_study(const char* name, const Shape& shape, bool quick, sim::Contact
   out.rise_every = largest_rise(every);
   out.rise_kept = largest_rise_of_kept_points(errors);
   out.rise_kept_20 = largest_rise_of_kept_points(errors, 20);
+  out.normal_median = sur.normal_median;
+  out.normal_p90 = sur.normal_p90;
   appendf(out.text,
           "%-26s %-10s %4d %8zu | %s | %s | %s | %s | %6.3f %6.3f | %3zu %6.3f %3zu %6.3f%s\n",
           name, mode == sim::ContactMode::per_tactel ? "per tactel" : "per pad", int(seed),
@@ -528,6 +548,26 @@ int main(int argc, char** argv) try {
       "Where a point has 100 contacts or more, averaging's chord sag shows and Surfel, which "
       "removes it, is ahead; at 20-99 the sag is smaller and about cancels the per-pad contacts' "
       "own outward bias, and both are limited by the contacts' noise.\n\n");
+  std::printf(
+      "Pad model, Surfel's point normals (its fitted surface's normal at the point): the angle "
+      "to the true surface normal there, over the points of at least 5 contacts, median / 90th "
+      "percentile in mrad, seeds 11, 12, 13\n");
+  std::printf("%-26s | %-33s | %s\n", "shape", "per tactel", "per pad");
+  for (std::size_t shape = 0; shape < pads.size() / 6; ++shape) {
+    std::printf("%-26s", pads[shape * 6].name.c_str());
+    for (std::size_t mode = 0; mode < 2; ++mode) {
+      std::printf(" |");
+      for (std::size_t seed = 0; seed < 3; ++seed) {
+        const PadLine& l = pads[shape * 6 + mode * 3 + seed];
+        std::printf(" %4.0f /%4.0f", 1e3 * l.normal_median, 1e3 * l.normal_p90);
+      }
+    }
+    std::printf("\n");
+  }
+  std::printf(
+      "Per pad, most of the worst tenth are points built from light touches alone: one or two "
+      "active tactels measure no slope, so every contact's normal is the pad's, stated as a "
+      "guess (0.21 rad). At edges, points also gather contacts from the next face.\n\n");
   std::printf(
       "Raw contacts per tactel by the true depth of their tactel (the three seeds pooled): signed "
       "error in mm, and the share of the contacts in each band\n");

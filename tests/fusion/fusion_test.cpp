@@ -735,6 +735,45 @@ TEST_CASE("Surfel weights a guessed normal's slope down by the sigma it states",
   CHECK(off_stated < 1e-5);
 }
 
+TEST_CASE("Surfel's normal is its fitted sphere's normal at the point it reports", "[fusion]") {
+  // Contacts with exact normals on a patch of a sphere of radius 40 mm around +z. Those with
+  // x > 0 are five times finer along the normal, so the point is reported above a centroid
+  // shifted towards them, where the plain mean of the contacts' normals is not the normal
+  // (about 1 mm away: 0.03 rad). A fifth of the contacts with x < 0 carry a guessed normal,
+  // 0.8 rad off and stated so (normal_sigma 0.21 rad), which the plain mean takes in full.
+  const double R = 0.04;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-3e-3, 3e-3);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const auto make = [&](std::uint32_t i, bool with_guesses) {
+    const double x = u(rng), y = u(rng);
+    const taxel::Vec3d n = taxel::Vec3d(x, y, R).normalized();
+    const double sn = x > 0 ? 0.1e-3 : 0.5e-3;
+    auto c = contact_at<double>(R * n + sn * g(rng) * n, taxel::pad_covariance(n, sn, 1e-3));
+    c.normal = n;
+    c.normal_sigma = 0.02;
+    if (with_guesses && x < 0 && i % 5 == 0) {
+      c.normal = (n + std::tan(0.8) * n.cross(taxel::Vec3d::UnitY()).normalized()).normalized();
+      c.normal_sigma = 0.21;
+    }
+    return c;
+  };
+  const tf::Surfel<double> surfel;
+  for (const bool with_guesses : {false, true}) {
+    auto s = surfel.init(make(0, with_guesses));
+    for (std::uint32_t i = 1; i < 2000; ++i) surfel.fuse(s, make(i, with_guesses), i);
+    const taxel::Vec3d truth = surfel.mean(s).normalized();  // the sphere's normal there
+    const double fitted = std::acos(std::min(1.0, truth.dot(surfel.normal(s))));
+    const double plain = std::acos(std::min(1.0, truth.dot(s.unit_normal)));
+    CAPTURE(with_guesses, fitted, plain);
+    CHECK(surfel.normal(s).norm() == Approx(1.0).epsilon(1e-12));
+    // With the guesses, their slopes' share ((0.05 / 0.21)^2 of a measured one's) still tilts
+    // the fit by about 2 mrad; the plain mean is tilted 0.1 rad.
+    CHECK(fitted < (with_guesses ? 5e-3 : 1e-3));
+    CHECK(plain > 0.03);  // the plain mean would fail the check above
+  }
+}
+
 TEST_CASE("a valid contact whose Surfel weight overflows is refused, not added as NaN",
           "[fusion]") {
   // Found by fuzzing: a variance of 1e-320 along the normal is valid (the determinant,

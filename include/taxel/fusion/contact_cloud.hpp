@@ -260,7 +260,7 @@ class ContactCloud {
   /// The points as a PointCloud, keeping those that pass `filter` (all by default), in id
   /// order. Fields: "observations"; the covariance [m^2] as "cov_xx", "cov_xy", "cov_xz",
   /// "cov_yy", "cov_yz", "cov_zz"; "last_time" [s]. Normals when the policy estimates them
-  /// (Surfel: the mean contact normal) and every kept point has one. Throws
+  /// (Surfel: its fitted surface's normal at the point) and every kept point has one. Throws
   /// std::invalid_argument for a NaN or negative max_sigma.
   [[nodiscard]] PointCloud<Scalar> to_point_cloud(const PointFilter& filter = {}) const {
     check_filter(filter);

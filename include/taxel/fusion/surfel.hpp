@@ -203,9 +203,23 @@ struct Surfel {
     const S z = s.sz * inv + sag;
     return s.origin + ux * s.t1 + uy * s.t2 + z * s.n0;
   }
-  /// The point's surface normal: the mean of its contacts' normals (unit), or zero when no
-  /// contact had one.
-  Vec3<S> normal(const State& s) const noexcept { return s.unit_normal; }
+  /// The point's surface normal (unit): the normal of the fitted quadric at the point `mean`
+  /// reports, from the contacts' slopes as the curvature fit weighs them, or zero when no
+  /// contact had a normal. The slope there is s(c) = s_mean + H (c - u_mean) (c the weighted
+  /// centroid of the offsets, u_mean and s_mean the fit's weighted means), and the normal is
+  /// n0 + s_x t1 + s_y t2, normalised. Unlike the plain mean of the contacts' normals (the
+  /// gate's reference), it is the normal at the reported point rather than at the contacts'
+  /// unweighted centroid, and a guessed normal counts only by its slope's share.
+  Vec3<S> normal(const State& s) const noexcept {
+    if (s.count < S(1)) return Vec3<S>::Zero();
+    S h[3];
+    fit_curvature(s, h);
+    const S inv = S(1) / s.vweight, inv_w = S(1) / s.weight;
+    const S dx = s.su[0] * inv_w - s.vu[0] * inv, dy = s.su[1] * inv_w - s.vu[1] * inv;
+    const S sx = s.ss[0] * inv + h[0] * dx + h[1] * dy;
+    const S sy = s.ss[1] * inv + h[1] * dx + h[2] * dy;
+    return (s.n0 + sx * s.t1 + sy * s.t2).normalized();
+  }
   /// The filter covariance P = J^-1 [m^2] (the sag term adds no variance).
   Mat3<S> covariance(const State& s) const noexcept {
     S p[6];
