@@ -772,6 +772,17 @@ TEST_CASE("Surfel's normal is its fitted sphere's normal at the point it reports
     CHECK(fitted < (with_guesses ? 5e-3 : 1e-3));
     CHECK(plain > 0.03);  // the plain mean would fail the check above
   }
+  // A normal_sigma that is valid but so large that every slope's share underflows leaves the
+  // fit no weight: the normal is then the plain mean, not 0 / 0.
+  auto c = make(1, false);
+  c.normal_sigma = 1e300;
+  auto s = surfel.init(c);
+  c.position.x() += 1e-3;
+  c.normal = taxel::Vec3d(0.1, 0, 1).normalized();
+  surfel.fuse(s, c, 1);
+  CHECK(s.vweight < std::numeric_limits<double>::min());
+  CHECK(surfel.normal(s).allFinite());
+  CHECK((surfel.normal(s) - s.unit_normal).norm() == 0);
 }
 
 TEST_CASE("a valid contact whose Surfel weight overflows is refused, not added as NaN",

@@ -3,7 +3,8 @@
 // indefinite; with a normal or without) and association gates (association_sigmas from the
 // first byte, so huge covariances widen the gate without bound), with Surfel's filter plain,
 // with process noise, with a Mahalanobis gate or both (also from the first byte): it must
-// never crash, reject exactly the invalid ones, and keep every fused point finite.
+// never crash, reject exactly the invalid ones, and keep every fused point (mean, covariance
+// and normal) finite.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -20,6 +21,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   --size;
   taxel::fusion::ContactCloud<> cloud(
       {.association_radius = 2e-3, .association_sigmas = sigmas, .fusion = {.kalman = filter}});
+  const taxel::fusion::Surfel<double> surfel({.kalman = filter});  // the cloud's policy
   // Position, upper triangle of the covariance, normal (used when its first byte is odd).
   constexpr std::size_t kDoubles = 3 + 6 + 3;
   while (size >= kDoubles * sizeof(double)) {
@@ -36,6 +38,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const taxel::Vec3d n(v[9], v[10], v[11]);
       // Mostly unit normals (a finite, non-zero vector normalised), sometimes the raw bits.
       c.normal = (flag & 2) && n.allFinite() && n.norm() > 0 ? taxel::Vec3d(n.normalized()) : n;
+      // Sometimes a stated normal uncertainty: any bits, so also huge, negative or NaN.
+      if (flag & 4) c.normal_sigma = v[10];
     }
     const bool valid = taxel::check_contact(c) == taxel::ContactDefect::ok;
     const std::size_t before = cloud.size();
@@ -52,7 +56,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       std::abort();
     }
     if (r.status != taxel::fusion::InsertStatus::rejected &&
-        (!cloud.mean(r.id).allFinite() || !cloud.covariance(r.id).allFinite())) {
+        (!cloud.mean(r.id).allFinite() || !cloud.covariance(r.id).allFinite() ||
+         !surfel.normal(cloud.state(r.id)).allFinite())) {
       std::abort();
     }
   }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -209,9 +210,12 @@ struct Surfel {
   /// centroid of the offsets, u_mean and s_mean the fit's weighted means), and the normal is
   /// n0 + s_x t1 + s_y t2, normalised. Unlike the plain mean of the contacts' normals (the
   /// gate's reference), it is the normal at the reported point rather than at the contacts'
-  /// unweighted centroid, and a guessed normal counts only by its slope's share.
+  /// unweighted centroid, and a guessed normal counts only by its slope's share. Where the
+  /// slopes' total weight is below the smallest normal number (every contact stated so large a
+  /// normal_sigma, around 1e150 rad, that its share underflowed), it is the plain mean.
   Vec3<S> normal(const State& s) const noexcept {
     if (s.count < S(1)) return Vec3<S>::Zero();
+    if (!(s.vweight >= std::numeric_limits<S>::min())) return s.unit_normal;
     S h[3];
     fit_curvature(s, h);
     const S inv = S(1) / s.vweight, inv_w = S(1) / s.weight;
