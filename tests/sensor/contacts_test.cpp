@@ -382,6 +382,43 @@ TEST_CASE("readings to contacts: the quadric's slope variance against the scatte
   }
 }
 
+TEST_CASE("readings to contacts: the stated normal uncertainty includes the pad's tilt",
+          "[sensor]") {
+  // Exact depths of a tilted plane, read through a pose the robot believes turned by a random
+  // small rotation (angle sigma_tilt N(0, 1) about a uniform axis, the kinematic noise the
+  // sensor model states). The normal turns with the pose: its angle to the true normal has
+  // mean square 2/3 sigma_tilt^2, which the contacts must state (the fit's own slope variance
+  // is nil here), per tactel and per pad.
+  tsn::SensorModel m = noiseless();
+  m.sigma_tilt = 0.05;
+  const auto counts = readings(m, [](double x, double y) { return 1.5e-3 + 0.1 * x - 0.05 * y; });
+  const Vec3d truth = -Vec3d(0.1, -0.05, 1.0).normalized();
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (const auto mode : {tsn::ContactMode::per_tactel, tsn::ContactMode::per_pad}) {
+    tsn::ContactExtractor ex(m, {.mode = mode});
+    double error2 = 0, stated2 = 0;
+    const int frames = 4000;
+    std::vector<taxel::Contact<double>> out;
+    for (int f = 0; f < frames; ++f) {
+      const Vec3d axis = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+      Eigen::Isometry3d believed = Eigen::Isometry3d::Identity();
+      believed.linear() = Eigen::AngleAxisd(m.sigma_tilt * gauss(rng), axis).matrix();
+      out.clear();
+      REQUIRE(ex.extract(counts, believed, 0.0, out) > 0);
+      const taxel::Contact<double>& c = out[out.size() / 2];
+      const double angle =
+          std::acos(std::clamp(c.normal->dot(believed.linear() * truth), -1.0, 1.0));
+      CHECK(angle < 1e-3);  // the pad-frame normal is exact
+      error2 += std::pow(std::acos(std::clamp(c.normal->dot(truth), -1.0, 1.0)), 2);
+      stated2 += c.normal_sigma * c.normal_sigma;
+    }
+    // A mean of 4000 squared angles (2 degrees of freedom each) against a constant: 1 +- 0.02.
+    CHECK(error2 / stated2 > 0.9);
+    CHECK(error2 / stated2 < 1.1);
+  }
+}
+
 TEST_CASE("readings to contacts: per pad, the quadric's point above the centroid", "[sensor]") {
   const tsn::SensorModel m = noiseless();
   tsn::ContactExtractor ex(m, {.mode = tsn::ContactMode::per_pad});
@@ -409,7 +446,18 @@ TEST_CASE("readings to contacts: each contact states its normal's uncertainty", 
     counts(5, 3) = 1000;
     REQUIRE(ex.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out) == 1);
     CHECK(*out[0].normal == Vec3d(0, 0, -1));
-    CHECK(out[0].normal_sigma == Approx(std::sqrt(2.0) * fb).epsilon(1e-12));
+    // Both slopes' fallback variance, and the pad's own tilt turning it (2/3 of sigma_tilt^2).
+    const double tilt2 = 2.0 / 3.0 * m.sigma_tilt * m.sigma_tilt;
+    CHECK(out[0].normal_sigma == Approx(std::sqrt(2.0 * fb * fb + tilt2)).epsilon(1e-12));
+  }
+  SECTION("without local normals every normal is the pad's, stated as unmeasured") {
+    const auto counts = readings(m, [](double x, double) { return 1e-3 + 0.2 * x; });
+    for (const auto mode : {tsn::ContactMode::per_tactel, tsn::ContactMode::per_pad}) {
+      tsn::ContactExtractor flat(m, {.mode = mode, .local_normals = false});
+      out.clear();
+      REQUIRE(flat.extract(counts, Eigen::Isometry3d::Identity(), 0.0, out) > 0);
+      for (const auto& c : out) CHECK(c.normal_sigma > std::sqrt(2.0) * fb);
+    }
   }
   SECTION("a row of tactels: the slope across it unmeasured") {
     tsn::PadMatrix counts = tsn::PadMatrix::Zero(m.geometry.rows, m.geometry.cols);

@@ -47,11 +47,14 @@
 //     sphere, against 0.93-0.98 from the quadric). Where the active neighbours span only a row
 //     or a column, the plane's slope across it is taken as zero, and where they span neither,
 //     the pad normal (-z) is used; a slope not measured gets the variance
-//     fallback_normal_sigma^2.
+//     fallback_normal_sigma^2 (without local_normals, both slopes of every contact). The
+//     pad's kinematic tilt turns the normal as well: an angle sigma_tilt about a uniform axis
+//     tilts it by 2/3 sigma_tilt^2 in mean square, which is added to the slope variances. The
+//     contact states the square root of that sum as its normal's uncertainty (normal_sigma).
 //  3. Covariance. Tight along that normal, wide across it:
 //       across:  s_t^2 = pitch^2 / 12 + sigma_position^2 + |xy|^2 sigma_tilt^2 / 6
 //       along:   s_n^2 = var d + sigma_position^2
-//                        + |xy|^2 sigma_tilt^2 / 3 + (pitch^2 / 12) (var g_x + var g_y)
+//                        + |xy|^2 sigma_tilt^2 / 3 + (pitch^2 / 12) normal_sigma^2
 //     (var d the corrected depth's variance of step 1, |xy| the tactel's lever arm from
 //     the pad origin; the last term is the normal's own uncertainty: a plane tilted by beta
 //     misstates the height by beta * u over a sideways offset u, and u spreads over the
@@ -315,6 +318,7 @@ class ContactExtractor {
                                    double pressure, double time) const {
     const double lever2 = x * x + y * y;
     const double vt = sn.q2 + sn.sp2 + lever2 * sn.st2_6;
+    slope_var += 2.0 * sn.st2_3;  // the pad's own tilt turns the normal too
     const double vn = var_along + sn.sp2 + lever2 * sn.st2_3 + sn.q2 * slope_var;
     Vec3d n = T.linear() * n_pad;       // unit already when T's rotation is orthonormal; made sure:
     const double n2 = n.squaredNorm();  // one Newton step for 1 / |n| when |n| is near 1
@@ -349,7 +353,8 @@ class ContactExtractor {
     const double* f = slope_var_;
     for (std::size_t i = 0; i < active_count_; ++i) {
       const Active& e = active_[i];
-      double gx = 0, gy = 0, vg = 0;  // slopes of d per metre, the sum of their variances
+      // Slopes of d per metre and the sum of their variances (unmeasured: the pad's normal).
+      double gx = 0, gy = 0, vg = 2.0 * fb2;
       double depth = padded_[e.at];
       if (quad_ok_) {
         // The pad-wide quadric's gradient at the tactel and its least-squares variances, and
@@ -642,7 +647,8 @@ class ContactExtractor {
       for (int a = 0; a < 6; ++a) fit[k] += e[a] * sol[a];
       inv_diag[k++] = detail_forward_norm2(l, inv_l, e);
     }
-    double gx = 0, gy = 0, slope_var = 0.0;
+    const double fb = options_.fallback_normal_sigma;
+    double gx = 0, gy = 0, slope_var = 2.0 * fb * fb;  // unmeasured: the pad's normal
     if (options_.local_normals) {
       gx = fit[1] / p;
       gy = fit[2] / p;
