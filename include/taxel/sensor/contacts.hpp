@@ -105,7 +105,7 @@ struct ContactOptions {
   /// reading (unbiased at the rim of a contact; about twice the cost per active tactel).
   bool refine_censoring = true;
   /// Angular standard deviation [rad] of a normal slope that the depth map cannot measure
-  /// (too few active neighbours); > 0.
+  /// (too few active neighbours, or every slope without local_normals); > 0.
   double fallback_normal_sigma = 0.15;
 
   /// Throws std::invalid_argument naming the field out of range.
