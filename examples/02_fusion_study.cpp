@@ -519,9 +519,10 @@ int main(int argc, char** argv) try {
   std::printf("Theory: with the same isotropic R for every contact, Kalman equals averaging.\n\n");
 
   std::printf(
-      "Both pads, Surfel's point normals: the angle to the true surface normal at the point, over "
-      "the points of at least 5 contacts, median / 90th percentile in mrad; its fitted surface's "
-      "normal (what it reports) and the plain mean of its contacts' normals\n");
+      "Both pads and the isotropic control, Surfel's point normals: the angle to the true surface "
+      "normal at the point, over the points of at least 5 contacts, median / 90th percentile in "
+      "mrad; its fitted surface's normal (what it reports) and the plain mean of its contacts' "
+      "normals\n");
   std::printf("%-26s | %-13s | %s\n", "shape", "fitted", "plain mean");
   for (const std::string& row : normal_rows) std::fputs(row.c_str(), stdout);
   std::printf(
