@@ -261,6 +261,13 @@ expect("${err}" "poses_q.csv:2: the quaternion")
 file(WRITE "${WORK_DIR}/poses_few.csv" "frame,pad,x,y,z,qw,qx,qy,qz\n0,0,0,0,0,1,0,0,0\n")
 run_tool("${TOOL}" 1 --readings grasp.npy --poses poses_few.csv x.ply)
 expect("${err}" "reads contact but has no pose")
+# A sensor model out of range (a depth noise of 1e300 m once overflowed into a crash; a
+# full-scale depth in millimetres given as metres): exit 1, the field named.
+run_tool("${TOOL}" 1 --readings grasp.npy --poses grasp_poses.csv --sigma-normal 1e300 x.ply)
+expect("${err}" "sigma_normal must be in")
+expect_one_line("${err}")
+run_tool("${TOOL}" 1 --readings grasp.npy --poses grasp_poses.csv --full-scale-depth 3 x.ply)
+expect("${err}" "full_scale_depth must be in")
 if(EXISTS "${WORK_DIR}/x.ply")
   message(FATAL_ERROR "a refused input left x.ply behind")
 endif()

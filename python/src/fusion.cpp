@@ -274,7 +274,8 @@ How a pad of rows x cols tactels at `pitch` [m] turns indentation into readings:
 pressed d [m] reads d / full_scale_depth * (levels - 1) counts plus Gaussian depth noise of
 sigma_normal [m]; readings below `threshold` read 0 (censored). sigma_position [m] and
 sigma_tilt [rad] are the per-frame noise of the pad pose. Defaults: a Weiss DSA 9205-like pad,
-14 x 6 tactels at 3.4 mm, 12-bit.)doc")
+14 x 6 tactels at 3.4 mm, 12-bit. Raises ValueError for a value out of range: the pitch in
+[1e-6, 1] m, full_scale_depth in (0, 1] m, the noises in [0, 1] m and sigma_tilt in [0, pi].)doc")
       .def(py::init([](int rows, int cols, double pitch, double full_scale_depth, int levels,
                        int threshold, double sigma_normal, double sigma_position,
                        double sigma_tilt) {

@@ -42,7 +42,8 @@ class SensorModel:
 pressed d [m] reads d / full_scale_depth * (levels - 1) counts plus Gaussian depth noise of
 sigma_normal [m]; readings below `threshold` read 0 (censored). sigma_position [m] and
 sigma_tilt [rad] are the per-frame noise of the pad pose. Defaults: a Weiss DSA 9205-like pad,
-14 x 6 tactels at 3.4 mm, 12-bit."""
+14 x 6 tactels at 3.4 mm, 12-bit. Raises ValueError for a value out of range: the pitch in
+[1e-6, 1] m, full_scale_depth in (0, 1] m, the noises in [0, 1] m and sigma_tilt in [0, pi]."""
     def __init__(self, rows: int = 14, cols: int = 6, pitch: float = 0.0034, full_scale_depth: float = 0.003, levels: int = 4096, threshold: int = 8, sigma_normal: float = 0.0003, sigma_position: float = 0.0002, sigma_tilt: float = 0.02) -> None: ...
     def __repr__(self) -> str: ...
     @property

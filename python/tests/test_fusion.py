@@ -225,6 +225,11 @@ def test_readings_errors():
         sensor.contacts_from_readings(readings, poses, model=sensor.SensorModel(levels=256, threshold=2))
     with pytest.raises(ValueError, match="threshold"):
         sensor.SensorModel(threshold=0)
+    # A length in millimetres given as metres, and a noise that would overflow the variances.
+    with pytest.raises(ValueError, match="pitch"):
+        sensor.SensorModel(pitch=3.4)
+    with pytest.raises(ValueError, match="sigma_normal"):
+        sensor.SensorModel(sigma_normal=1e300)
 
 
 def test_refined_and_plug_in_censoring_corrections():

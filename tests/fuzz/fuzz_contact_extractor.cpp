@@ -1,28 +1,42 @@
 // SPDX-License-Identifier: MIT
 // Fuzzes sensor::ContactExtractor, differentially: the first bytes pick the pad size (1-16 x
-// 1-16), the levels, the threshold, the mode and the options; the rest are frames of readings
+// 1-16), the levels, the threshold, the mode and the options, and the model's lengths and
+// noise over the whole range SensorModel::validate accepts (pitch 1 um - 1 m, full-scale
+// depth 1e-12 - 1 m, noise 0 or 1e-9 - 1 m, tilt 0 - pi); the rest are frames of readings
 // (two bytes a tactel, any value, saturated and above the levels included). Every frame goes
 // through one extractor, which keeps its workspace from frame to frame, and through a new one:
 // the contacts must be the same bits, and every contact valid (finite, symmetric positive
 // definite covariance, unit normal); per tactel, there must be one contact per active tactel.
 // Nothing may throw: the readings always fit the pad.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <numbers>
 #include <taxel/core/contact.hpp>
 #include <taxel/sensor/contacts.hpp>
 #include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  if (size < 6) return 0;
+  constexpr std::size_t kHeader = 11;
+  if (size < kHeader) return 0;
   namespace tsn = taxel::sensor;
   tsn::SensorModel m;
   m.geometry.rows = 1 + data[0] % 16;
   m.geometry.cols = 1 + data[1] % 16;
   m.levels = 2 + (data[2] | (data[3] & 0x0f) << 8);  // 2 .. 4097
   m.threshold = 1 + data[4] % (m.levels - 1);
-  m.sigma_normal = (data[5] & 0x10) ? 0.0 : 0.3e-3;
+  // 10^(low + span * byte / 255), the ends included exactly.
+  const auto log_range = [](std::uint8_t b, int low, int span) {
+    return b == 255 ? std::pow(10.0, low + span) : std::pow(10.0, low + span * (b / 255.0));
+  };
+  m.geometry.pitch = log_range(data[6], -6, 6);
+  m.full_scale_depth = log_range(data[7], -12, 12);
+  m.sigma_normal = (data[5] & 0x10) ? 0.0 : log_range(data[8], -9, 9);
+  m.sigma_position = (data[5] & 0x20) ? 0.0 : log_range(data[9], -9, 9);
+  m.sigma_tilt = std::numbers::pi * (data[10] / 255.0);
+  m.validate();  // (in range by construction: a throw here is a finding)
   const tsn::ContactOptions opt{
       .mode = (data[5] & 1) ? tsn::ContactMode::per_pad : tsn::ContactMode::per_tactel,
       .local_normals = (data[5] & 2) != 0,
@@ -33,7 +47,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = Eigen::AngleAxisd(0.3, taxel::Vec3d(1, 2, 3).normalized()).matrix();
   std::vector<taxel::Contact<double>> a, b;
-  for (std::size_t at = 6; at + 2 * tactels <= size; at += 2 * tactels) {
+  for (std::size_t at = kHeader; at + 2 * tactels <= size; at += 2 * tactels) {
     tsn::PadMatrix counts(m.geometry.rows, m.geometry.cols);
     std::size_t active = 0;
     for (std::size_t i = 0; i < tactels; ++i) {

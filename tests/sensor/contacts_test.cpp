@@ -7,6 +7,7 @@
 #include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <taxel/sensor.hpp>
 #include <taxel/sim/exploration.hpp>
@@ -596,9 +597,60 @@ TEST_CASE("readings to contacts: bad input is refused", "[sensor]") {
   tsn::SensorModel wrong;
   wrong.threshold = 0;
   CHECK_THROWS_WITH(tsn::ContactExtractor{wrong}, Contains("threshold"));
+  // Lengths beyond a metre (a depth noise of 1e300 m overflowed the variances to infinity and
+  // the censoring table's index to garbage), NaN, and a pitch below a micrometre.
+  const auto refused = [](auto&& edit, const char* field) {
+    tsn::SensorModel m;
+    edit(m);
+    CHECK_THROWS_WITH(tsn::ContactExtractor{m}, Contains(field));
+  };
+  for (const double v : {1e300, 1.5, -1e-3, std::nan("")}) {
+    refused([v](tsn::SensorModel& m) { m.geometry.pitch = v; }, "pitch");
+    refused([v](tsn::SensorModel& m) { m.full_scale_depth = v; }, "full_scale_depth");
+    refused([v](tsn::SensorModel& m) { m.sigma_normal = v; }, "sigma_normal");
+    refused([v](tsn::SensorModel& m) { m.sigma_position = v; }, "sigma_position");
+    refused([v](tsn::SensorModel& m) { m.sigma_tilt = 4 * v; }, "sigma_tilt");
+  }
+  refused([](tsn::SensorModel& m) { m.geometry.pitch = 1e-300; }, "pitch");
+  refused([](tsn::SensorModel& m) { m.full_scale_depth = 0; }, "full_scale_depth");
   // Nothing active: no contact, nothing appended.
   CHECK(ex.extract(tsn::PadMatrix::Zero(14, 6), Eigen::Isometry3d::Identity(), 0, out) == 0);
   CHECK(out.empty());
+}
+
+TEST_CASE("readings to contacts: a sensor model at its bounds gives valid contacts", "[sensor]") {
+  // The largest and smallest model the validation accepts, random readings in every mode: each
+  // contact finite, its covariance symmetric positive definite and its normal a unit vector
+  // (check_contact), so that a fusion takes it.
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> count(0, 4095);
+  for (const bool large : {true, false}) {
+    tsn::SensorModel m;
+    m.geometry.pitch = large ? 1.0 : 1e-6;
+    m.full_scale_depth = large ? 1.0 : 1e-300;
+    m.sigma_normal = large ? 1.0 : 0.0;
+    m.sigma_position = large ? 1.0 : 0.0;
+    m.sigma_tilt = large ? std::numbers::pi : 0.0;
+    for (const auto mode : {tsn::ContactMode::per_tactel, tsn::ContactMode::per_pad}) {
+      tsn::ContactExtractor ex(m, {.mode = mode});
+      std::vector<taxel::Contact<double>> out;
+      Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+      pose.linear() = Eigen::AngleAxisd(0.7, Vec3d(1, -2, 3).normalized()).matrix();
+      pose.translation() = Vec3d(0.4, -0.1, 0.2);
+      for (int frame = 0; frame < 50; ++frame) {
+        tsn::PadMatrix counts(14, 6);
+        // Dense frames, then sparse ones (a few tactels: per tactel, plane fits).
+        for (auto& k : counts.reshaped()) {
+          k = static_cast<std::uint16_t>(frame < 25 || count(rng) < 600 ? count(rng) : 0);
+        }
+        ex.extract(counts, pose, 0.0, out);
+      }
+      REQUIRE(!out.empty());
+      std::size_t bad = 0;
+      for (const auto& c : out) bad += taxel::check_contact(c) != taxel::ContactDefect::ok;
+      CHECK(bad == 0);
+    }
+  }
 }
 
 TEST_CASE("readings to contacts: an extractor reused over frames gives what a new one gives",

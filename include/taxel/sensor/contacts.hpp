@@ -56,8 +56,10 @@
 //       along:   s_n^2 = var d + sigma_position^2
 //                        + |xy|^2 sigma_tilt^2 / 3 + (pitch^2 / 12) normal_sigma^2
 //     (var d the corrected depth's variance of step 1, |xy| the tactel's lever arm from
-//     the pad origin; the last term is the normal's own uncertainty: a plane tilted by beta
-//     misstates the height by beta * u over a sideways offset u, and u spreads over the
+//     the pad origin; s_t^2 is kept at least 1e-6 s_n^2 and s_n^2 at least 1e-12 s_t^2, so
+//     that the covariance stays positive definite in floating point, which only models far
+//     from any tactile pad reach; the last term is the normal's own uncertainty: a plane tilted by
+//     beta misstates the height by beta * u over a sideways offset u, and u spreads over the
 //     tactel's footprint). The slope variances are the least-squares ones of the quadric or
 //     the plane, (sigma_normal^2 + dq^2 / 12) e' A^-1 e with A the fit's normal matrix and e
 //     the derivative of its row of monomials. For the quadric this leaves out how the censoring
@@ -317,9 +319,15 @@ class ContactExtractor {
                                    const Vec3d& n_pad, double var_along, double slope_var,
                                    double pressure, double time) const {
     const double lever2 = x * x + y * y;
-    const double vt = sn.q2 + sn.sp2 + lever2 * sn.st2_6;
     slope_var += 2.0 * sn.st2_3;  // the pad's own tilt turns the normal too
-    const double vn = var_along + sn.sp2 + lever2 * sn.st2_3 + sn.q2 * slope_var;
+    const double vt0 = sn.q2 + sn.sp2 + lever2 * sn.st2_6;
+    const double vn0 = var_along + sn.sp2 + lever2 * sn.st2_3 + sn.q2 * slope_var;
+    // (Each kept within a bound of the other, which no tactile pad comes near, so that the
+    // covariance stays positive definite in floating point: a model without noise and with a
+    // vanishing depth per count would state nothing along the normal, and a micrometre pitch
+    // under a metre of depth noise next to nothing across.)
+    const double vt = std::max(vt0, 1e-6 * vn0);
+    const double vn = std::max(vn0, 1e-12 * vt);
     Vec3d n = T.linear() * n_pad;       // unit already when T's rotation is orthonormal; made sure:
     const double n2 = n.squaredNorm();  // one Newton step for 1 / |n| when |n| is near 1
     n *= std::abs(n2 - 1.0) < 1e-6 ? 1.5 - 0.5 * n2 : 1.0 / std::sqrt(n2);
@@ -407,7 +415,10 @@ class ContactExtractor {
   Censoring censoring() const { return {censor_depth_, inv_sigma_, model_.sigma_normal, lambda_}; }
   static Refined refined(const Censoring& c, const Active& e, double f) {
     const double a = (c.t - f) * c.inv_sigma;
-    const double u = std::clamp((a - kTableLow) * kTableScale, 0.0, double(kTable - 1) - 1e-9);
+    // (max before min, with the bound first: a NaN, which a valid model and pose never give,
+    // still lands in the table rather than becoming an index out of range.)
+    const double u =
+        std::min(std::max(0.0, (a - kTableLow) * kTableScale), double(kTable - 1) - 1e-9);
     const int k = static_cast<int>(u);
     const double w = u - k;
     const double* row = c.table[k];

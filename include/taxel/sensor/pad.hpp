@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -35,32 +36,37 @@ struct PadGeometry {
 /// `threshold` are reported as zero (the noise floor), so they are censored, not missing.
 struct SensorModel {
   PadGeometry geometry;
-  double full_scale_depth = 3e-3;  ///< indentation that saturates a tactel [m], > 0
+  double full_scale_depth = 3e-3;  ///< indentation that saturates a tactel [m], in (0, 1]
   int levels = 4096;               ///< reading levels (12-bit like the DSA), >= 2
   int threshold = 8;               ///< readings below this are zero (noise floor), >= 1
-  double sigma_normal = 0.3e-3;    ///< depth noise of a touching tactel, along the normal [m]
-  double sigma_position = 0.2e-3;  ///< kinematic translation noise of the pad, per frame [m]
-  double sigma_tilt = 0.02;  ///< kinematic rotation noise of the pad, per frame: angle std [rad]
+  /// Depth noise of a touching tactel, along the normal [m], in [0, 1].
+  double sigma_normal = 0.3e-3;
+  double sigma_position = 0.2e-3;  ///< kinematic translation noise of the pad [m], in [0, 1]
+  /// Kinematic rotation noise of the pad, per frame: angle standard deviation [rad], in [0, pi].
+  double sigma_tilt = 0.02;
 
   /// Depth of one reading count [m].
   double depth_per_count() const { return full_scale_depth / double(levels - 1); }
 
-  /// Throws std::invalid_argument naming the first parameter out of range.
+  /// Throws std::invalid_argument naming the first parameter out of range. The lengths are
+  /// bounded by a metre (and the pitch below by a micrometre): no tactile pad comes near, a
+  /// value beyond is a unit mistaken, and within these bounds every variance the contacts state
+  /// stays finite (beyond them, a depth noise of 1e300 m overflows to infinity).
   void validate() const {
     const auto need = [](bool ok, const char* what) {
       if (!ok) throw std::invalid_argument(std::string("SensorModel: ") + what);
     };
     need(geometry.rows >= 1 && geometry.cols >= 1, "rows and cols must be >= 1");
     need(geometry.rows <= 4096 && geometry.cols <= 4096, "rows and cols must be <= 4096");
-    need(geometry.pitch > 0 && std::isfinite(geometry.pitch), "pitch must be finite and > 0");
-    need(full_scale_depth > 0 && std::isfinite(full_scale_depth),
-         "full_scale_depth must be finite and > 0");
+    need(geometry.pitch >= 1e-6 && geometry.pitch <= 1.0,
+         "pitch must be in [1e-6, 1] m (a length in millimetres given as metres?)");
+    need(full_scale_depth > 0 && full_scale_depth <= 1.0,
+         "full_scale_depth must be in (0, 1] m (a length in millimetres given as metres?)");
     need(levels >= 2 && levels <= 65536, "levels must be in [2, 65536]");
     need(threshold >= 1 && threshold < levels, "threshold must be in [1, levels)");
-    need(sigma_normal >= 0 && std::isfinite(sigma_normal), "sigma_normal must be finite, >= 0");
-    need(sigma_position >= 0 && std::isfinite(sigma_position),
-         "sigma_position must be finite, >= 0");
-    need(sigma_tilt >= 0 && std::isfinite(sigma_tilt), "sigma_tilt must be finite, >= 0");
+    need(sigma_normal >= 0 && sigma_normal <= 1.0, "sigma_normal must be in [0, 1] m");
+    need(sigma_position >= 0 && sigma_position <= 1.0, "sigma_position must be in [0, 1] m");
+    need(sigma_tilt >= 0 && sigma_tilt <= std::numbers::pi, "sigma_tilt must be in [0, pi] rad");
   }
 };
 
