@@ -462,6 +462,44 @@ TEST_CASE("ContactCloud rejects bad configuration naming the field", "[fusion]")
                     Contains("normal_sigma"));
   CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.curvature_prior = -1.0}}),
                     Contains("curvature_prior"));
+  // Beyond the bounds the ridge (normal_sigma / curvature_prior)^2 overflows (found by
+  // fuzzing: a prior of 1e-250 / m gave NaN normals) or means nothing physical.
+  for (const double v : {1e-250, 1e-7, 4.0, 1e300, std::nan("")}) {
+    CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.normal_sigma = v}}),
+                      Contains("normal_sigma must be in"));
+  }
+  for (const double v : {1e-250, 1e-7, 1e10, 1e300, std::nan("")}) {
+    CHECK_THROWS_WITH(tf::ContactCloud<>({.fusion = {.curvature_prior = v}}),
+                      Contains("curvature_prior must be in"));
+  }
+  // At the bounds, in float and double, a curved patch fuses into points with finite means,
+  // covariances and unit normals.
+  const auto at_bounds = [](auto scalar) {
+    using S = decltype(scalar);
+    for (const S ns : {S(1e-6), S(3.141592653589793)}) {
+      for (const S prior : {S(1e-6), S(1e9)}) {
+        tf::ContactCloud<tf::Surfel<S>> cloud(
+            {.association_radius = S(4e-3),
+             .fusion = {.normal_sigma = ns, .curvature_prior = prior}});
+        for (int i = 0; i < 200; ++i) {
+          const S a = S(0.002) * S(i % 20), b = S(0.002) * S(i / 20);
+          taxel::Contact<S> c;
+          c.position = {a, b, (a * a + b * b) / S(0.08)};  // a 40 mm paraboloid
+          c.covariance = taxel::Mat3<S>::Identity() * S(1e-8);
+          c.normal = taxel::Vec3<S>(-a / S(0.04), -b / S(0.04), S(1)).normalized();
+          REQUIRE(cloud.insert(c).status != tf::InsertStatus::rejected);
+        }
+        const auto pc = cloud.to_point_cloud();
+        REQUIRE(pc.size() > 0);
+        for (std::size_t i = 0; i < pc.size(); ++i) {
+          CHECK(pc.points[i].allFinite());
+          CHECK(std::abs(pc.normals[i].norm() - S(1)) < S(1e-3));
+        }
+      }
+    }
+  };
+  at_bounds(0.0);
+  at_bounds(0.0f);
   CHECK_THROWS_WITH(tf::ContactCloud<tf::Average<double>>(
                         {.fusion = {.mode = tf::Average<double>::Mode::exponential, .alpha = 1.5}}),
                     Contains("alpha"));

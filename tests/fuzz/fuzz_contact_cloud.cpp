@@ -2,9 +2,13 @@
 // Fuzzes ContactCloud::insert with arbitrary contacts (any bit patterns, NaN, Inf, huge,
 // indefinite; with a normal or without) and association gates (association_sigmas from the
 // first byte, so huge covariances widen the gate without bound), with Surfel's filter plain,
-// with process noise, with a Mahalanobis gate or both (also from the first byte): it must
-// never crash, reject exactly the invalid ones, and keep every fused point (mean, covariance
-// and normal) finite.
+// with process noise, with a Mahalanobis gate or both (also from the first byte), and the
+// association radius and Surfel's normal noise, curvature prior and largest normal angle from
+// the next four bytes, over the whole ranges the configurations accept: it must never crash,
+// reject exactly the invalid ones, and keep every fused point (mean, covariance and normal)
+// finite.
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -12,16 +16,28 @@
 #include <taxel/fusion.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  if (size < 1) return 0;
+  constexpr std::size_t kHeader = 5;
+  if (size < kHeader) return 0;
   const double sigmas = double(data[0] % 16);  // 0 (fixed gate) .. 15
   taxel::fusion::Kalman<double>::Config filter;
   if (data[0] & 16) filter.process_noise = 1e-4;
   if (data[0] & 32) filter.gate_chi2 = taxel::fusion::kChi2Dof3P99;
-  ++data;
-  --size;
+  // Log-uniform in [lo, hi] by a byte; the radius up to the metre the cloud accepts, the
+  // policy's scales over the ranges Surfel accepts, the angle over (0, pi/2).
+  const auto log_range = [](std::uint8_t b, double lo, double hi) {
+    return std::clamp(lo * std::pow(hi / lo, b / 255.0), lo, hi);
+  };
+  const double radius = log_range(data[1], 1e-7, 1.0);
+  const taxel::fusion::Surfel<double>::Config policy{
+      .kalman = filter,
+      .max_normal_angle = 1.5707963267948966 * (0.5 + data[2]) / 256.0,
+      .normal_sigma = log_range(data[3], 1e-6, 3.141592653589793),
+      .curvature_prior = log_range(data[4], 1e-6, 1e9)};
+  data += kHeader;
+  size -= kHeader;
   taxel::fusion::ContactCloud<> cloud(
-      {.association_radius = 2e-3, .association_sigmas = sigmas, .fusion = {.kalman = filter}});
-  const taxel::fusion::Surfel<double> surfel({.kalman = filter});  // the cloud's policy
+      {.association_radius = radius, .association_sigmas = sigmas, .fusion = policy});
+  const taxel::fusion::Surfel<double> surfel(policy);  // the cloud's policy
   // Position, upper triangle of the covariance, normal (used when its first byte is odd).
   constexpr std::size_t kDoubles = 3 + 6 + 3;
   while (size >= kDoubles * sizeof(double)) {

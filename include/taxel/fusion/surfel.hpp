@@ -65,8 +65,9 @@ struct Surfel {
     typename Kalman<S>::Config kalman{};  ///< process noise, gate and P0 of the filter
     S max_normal_angle =
         S(1.2);  ///< contacts turned further [rad] are not curvature data, in (0, pi/2)
-    S normal_sigma = S(0.05);    ///< noise of a contact normal [rad], > 0
-    S curvature_prior = S(100);  ///< prior standard deviation of the curvature [1/m], > 0
+    S normal_sigma = S(0.05);  ///< noise of a contact normal [rad], in [1e-6, pi]
+    /// Prior standard deviation of the curvature [1/m], in [1e-6, 1e9].
+    S curvature_prior = S(100);
   };
   /// A fused point: the filter in information form, its tangent frame and the curvature sums.
   /// Every member starts at zero (Eigen's vectors would otherwise start uninitialised, even in
@@ -105,13 +106,17 @@ struct Surfel {
       throw std::invalid_argument("Surfel::Config::max_normal_angle must be in (0, pi/2), got " +
                                   std::to_string(config.max_normal_angle));
     }
-    if (!(config.normal_sigma > S(0)) || !std::isfinite(config.normal_sigma)) {
-      throw std::invalid_argument("Surfel::Config::normal_sigma must be finite and > 0, got " +
+    // (Bounded so that the ridge (normal_sigma / curvature_prior)^2 stays a finite, normal
+    // number in float too: a curvature prior of 1e-250 / m made it infinite, and the fitted
+    // normal NaN.)
+    if (!(config.normal_sigma >= S(1e-6)) || !(config.normal_sigma <= S(3.141592653589793))) {
+      throw std::invalid_argument("Surfel::Config::normal_sigma must be in [1e-6, pi] rad, got " +
                                   std::to_string(config.normal_sigma));
     }
-    if (!(config.curvature_prior > S(0)) || !std::isfinite(config.curvature_prior)) {
-      throw std::invalid_argument("Surfel::Config::curvature_prior must be finite and > 0, got " +
-                                  std::to_string(config.curvature_prior));
+    if (!(config.curvature_prior >= S(1e-6)) || !(config.curvature_prior <= S(1e9))) {
+      throw std::invalid_argument(
+          "Surfel::Config::curvature_prior must be in [1e-6, 1e9] 1/m, got " +
+          std::to_string(config.curvature_prior));
     }
     cos_max_ = std::cos(config.max_normal_angle);
     q2_ = config.kalman.process_noise * config.kalman.process_noise;
