@@ -21,7 +21,7 @@ namespace taxel::sensor {
 struct PadGeometry {
   int rows = 14;          ///< tactel rows, >= 1
   int cols = 6;           ///< tactel columns, >= 1
-  double pitch = 3.4e-3;  ///< centre-to-centre distance [m], > 0
+  double pitch = 3.4e-3;  ///< centre-to-centre distance [m], in [1e-6, 1]
 
   /// Centre of tactel (r, c) in the pad frame [m].
   Vec3d tactel(int r, int c) const {
