@@ -3,8 +3,9 @@
 // Icp (both errors) and ObjectLibrary, on fuzzer-chosen clouds. The first byte picks how the
 // rest becomes coordinates: raw doubles (any finite value, huge ones included), small integers
 // on a millimetre lattice (duplicates and flat or collinear sets), or one axis only (collinear).
-// Every call must return or throw std::invalid_argument; answers must match brute force, and
-// every transform must be finite.
+// ICP's options come from the input's last bytes. Every call must return or throw
+// std::invalid_argument; answers must match brute force, and every transform must be finite.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -99,20 +100,36 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check_against_brute(target, pts, Vec3d(0, 0, 0));
 
     // ICP of the cloud onto itself from a small offset: whatever the status, finite numbers.
+    // Its options come from the input's last five bytes, over the ranges IcpConfig accepts:
+    // the distance gate 1e-9 - 1e3 m or none, trimming 0 - 0.99, tolerances 1e-15 - 1,
+    // approximate correspondences and a coarse stage of up to 63 points.
+    const std::uint8_t* tail = data + (size >= 5 ? size - 5 : 0);
+    const bool options = size >= 6;
+    const auto log_range = [](std::uint8_t b, double lo, double hi) {
+      return std::clamp(lo * std::pow(hi / lo, b / 255.0), lo, hi);
+    };
+    tr::IcpConfig config{.max_iterations = 10};
+    if (options) {
+      config.max_distance =
+          tail[0] == 255 ? std::numeric_limits<double>::infinity() : log_range(tail[0], 1e-9, 1e3);
+      config.trim_fraction = 0.99 * (tail[1] / 255.0);
+      config.translation_tolerance = log_range(tail[2], 1e-15, 1.0);
+      config.rotation_tolerance = log_range(tail[3], 1e-15, 1.0);
+      config.approximate = (tail[4] & 64) != 0;
+      config.coarse_points = tail[4] & 63;
+    }
     Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
     start.translation() = Vec3d(1e-3, 0, -1e-3);
     const std::span<const Vec3d> source(pts);
-    const tr::IcpResult a =
-        tr::Icp<tr::PointToPlane>({.max_iterations = 10}).align(target, source, start);
-    const tr::IcpResult b =
-        tr::Icp<tr::PointToPoint>({.max_iterations = 10}).align(target, source, start);
+    const tr::IcpResult a = tr::Icp<tr::PointToPlane>(config).align(target, source, start);
+    const tr::IcpResult b = tr::Icp<tr::PointToPoint>(config).align(target, source, start);
     for (const auto* r : {&a, &b}) {
       if (!r->transform.matrix().allFinite() || !std::isfinite(r->rmse)) std::abort();
     }
     // Keeping stable matches changes no correspondence, so no bit of the result.
-    const tr::IcpResult c =
-        tr::Icp<tr::PointToPlane>({.max_iterations = 10, .keep_stable_matches = false})
-            .align(target, source, start);
+    tr::IcpConfig searching = config;
+    searching.keep_stable_matches = false;
+    const tr::IcpResult c = tr::Icp<tr::PointToPlane>(searching).align(target, source, start);
     if (!(c.transform.matrix() == a.transform.matrix()) || !(c.rmse == a.rmse) ||
         c.iterations != a.iterations) {
       std::abort();
