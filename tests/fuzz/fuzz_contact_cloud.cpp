@@ -7,13 +7,13 @@
 // the next four bytes, over the whole ranges the configurations accept: it must never crash,
 // reject exactly the invalid ones, and keep every fused point (mean, covariance and normal)
 // finite.
-#include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <taxel/fusion.hpp>
+
+#include "byte_range.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   constexpr std::size_t kHeader = 5;
@@ -22,11 +22,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   taxel::fusion::Kalman<double>::Config filter;
   if (data[0] & 16) filter.process_noise = 1e-4;
   if (data[0] & 32) filter.gate_chi2 = taxel::fusion::kChi2Dof3P99;
-  // Log-uniform in [lo, hi] by a byte; the radius up to the metre the cloud accepts, the
-  // policy's scales over the ranges Surfel accepts, the angle over (0, pi/2).
-  const auto log_range = [](std::uint8_t b, double lo, double hi) {
-    return std::clamp(lo * std::pow(hi / lo, b / 255.0), lo, hi);
-  };
+  // The radius up to the metre the cloud accepts, the policy's scales over the ranges Surfel
+  // accepts, the angle over (0, pi/2).
+  using taxel::fuzz::log_range;
   const double radius = log_range(data[1], 1e-7, 1.0);
   const taxel::fusion::Surfel<double>::Config policy{
       .kalman = filter,

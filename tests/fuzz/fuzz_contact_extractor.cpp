@@ -8,7 +8,6 @@
 // the contacts must be the same bits, and every contact valid (finite, symmetric positive
 // definite covariance, unit normal); per tactel, there must be one contact per active tactel.
 // Nothing may throw: the readings always fit the pad.
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -17,6 +16,8 @@
 #include <taxel/core/contact.hpp>
 #include <taxel/sensor/contacts.hpp>
 #include <vector>
+
+#include "byte_range.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   constexpr std::size_t kHeader = 11;
@@ -27,14 +28,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   m.geometry.cols = 1 + data[1] % 16;
   m.levels = 2 + (data[2] | (data[3] & 0x0f) << 8);  // 2 .. 4097
   m.threshold = 1 + data[4] % (m.levels - 1);
-  // 10^(low + span * byte / 255), the ends included exactly.
-  const auto log_range = [](std::uint8_t b, int low, int span) {
-    return b == 255 ? std::pow(10.0, low + span) : std::pow(10.0, low + span * (b / 255.0));
-  };
-  m.geometry.pitch = log_range(data[6], -6, 6);
-  m.full_scale_depth = log_range(data[7], -12, 12);
-  m.sigma_normal = (data[5] & 0x10) ? 0.0 : log_range(data[8], -9, 9);
-  m.sigma_position = (data[5] & 0x20) ? 0.0 : log_range(data[9], -9, 9);
+  using taxel::fuzz::log_range;
+  m.geometry.pitch = log_range(data[6], 1e-6, 1.0);
+  m.full_scale_depth = log_range(data[7], 1e-12, 1.0);
+  m.sigma_normal = (data[5] & 0x10) ? 0.0 : log_range(data[8], 1e-9, 1.0);
+  m.sigma_position = (data[5] & 0x20) ? 0.0 : log_range(data[9], 1e-9, 1.0);
   m.sigma_tilt = std::numbers::pi * (data[10] / 255.0);
   m.validate();  // (in range by construction: a throw here is a finding)
   const tsn::ContactOptions opt{

@@ -5,7 +5,6 @@
 // on a millimetre lattice (duplicates and flat or collinear sets), or one axis only (collinear).
 // ICP's options come from the input's last bytes. Every call must return or throw
 // std::invalid_argument; answers must match brute force, and every transform must be finite.
-#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +16,8 @@
 #include <taxel/index/uniform_grid.hpp>
 #include <taxel/registration.hpp>
 #include <vector>
+
+#include "byte_range.hpp"
 
 namespace {
 
@@ -103,13 +104,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // Its options come from the input's last five bytes, over the ranges IcpConfig accepts:
     // the distance gate 1e-9 - 1e3 m or none, trimming 0 - 0.99, tolerances 1e-15 - 1,
     // approximate correspondences and a coarse stage of up to 63 points.
-    const std::uint8_t* tail = data + (size >= 5 ? size - 5 : 0);
-    const bool options = size >= 6;
-    const auto log_range = [](std::uint8_t b, double lo, double hi) {
-      return std::clamp(lo * std::pow(hi / lo, b / 255.0), lo, hi);
-    };
     tr::IcpConfig config{.max_iterations = 10};
-    if (options) {
+    if (size >= 6) {
+      using taxel::fuzz::log_range;
+      const std::uint8_t* tail = data + size - 5;
       config.max_distance =
           tail[0] == 255 ? std::numeric_limits<double>::infinity() : log_range(tail[0], 1e-9, 1e3);
       config.trim_fraction = 0.99 * (tail[1] / 255.0);
