@@ -142,6 +142,8 @@ def test_segmentation_and_reconstruction_on_stacks():
     np.testing.assert_array_equal(one.classes, km.labels(images[0]).reshape(images[0].shape))
     h = image.rec_edged(one)
     assert h.shape == images[0].shape and np.isfinite(h).all()
+    with pytest.raises(ValueError, match=r"RecEdgedConfig::k must be in \[-1e6, 1e6\]"):
+        image.rec_edged(one, k=1e300)
     e = image.rec_edgeless(images[0], one, degree=2)
     assert e.shape == images[0].shape and (e[one.classes == 0] == 0).mean() > 0.5
     with pytest.raises(ValueError):

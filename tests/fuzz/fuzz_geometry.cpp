@@ -3,8 +3,9 @@
 // Icp (both errors) and ObjectLibrary, on fuzzer-chosen clouds. The first byte picks how the
 // rest becomes coordinates: raw doubles (any finite value, huge ones included), small integers
 // on a millimetre lattice (duplicates and flat or collinear sets), or one axis only (collinear).
-// ICP's options come from the input's last bytes. Every call must return or throw
-// std::invalid_argument; answers must match brute force, and every transform must be finite.
+// ICP's and the object library's options come from the input's last bytes. Every call must
+// return or throw std::invalid_argument; answers must match brute force, and every transform
+// must be finite.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -133,8 +134,30 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       std::abort();
     }
 
+    // The library's options from the four bytes before ICP's, over the ranges LibraryConfig
+    // accepts (iteration and start counts kept small for the fuzzer's speed), with ICP's
+    // options above as its refinement.
     tr::LibraryConfig lc;
     lc.rotation_starts = 2;
+    if (size >= 10) {
+      using taxel::fuzz::log_range;
+      const std::uint8_t* head = data + size - 9;
+      lc.refine = config;
+      lc.coarse_iterations = 1 + head[0] % 12;
+      lc.coarse_points = 6 + (std::size_t{1} << (head[0] / 12 % 11)) - 1;
+      lc.refine_points = 6 + (std::size_t{1} << (head[1] % 11)) - 1;
+      lc.coarse_trim = 0.99 * ((head[1] >> 4) / 15.0);
+      lc.pca_starts = (head[2] & 1) != 0;
+      lc.rotation_starts = lc.pca_starts ? (head[2] >> 1) % 25 : 1 + (head[2] >> 1) % 24;
+      lc.refine_best = 1 + (head[2] >> 6);
+      lc.exact_models = 1 + (head[3] & 3);
+      lc.hopeless_factor = (head[3] & 4) != 0 ? std::numeric_limits<double>::infinity()
+                                              : log_range(head[3], 1.0 + 1e-12, 1e6);
+      lc.field_cell = (head[3] & 8) != 0 ? 0.0 : log_range(head[0], 1e-6, 1.0);
+      lc.score_gate = log_range(head[1], 1e-9, 1e3);
+      lc.unknown_score = log_range(head[2], 1e-9, 1e3);
+      lc.threads = 1 + (head[3] >> 7);
+    }
     tr::ObjectLibrary<double> library(lc);
     library.add("model", cloud, {.field_max_cells = 512});
     const tr::ObjectRecognition rec = library.recognize(cloud);

@@ -740,6 +740,36 @@ TEST_CASE("reconstruction: RecEdged plateau, RecEdgeless recovers polynomials", 
   CHECK(rec.rec_edged(zs).isZero());
   CHECK_THROWS_AS(ti::Reconstructor({}, {.degree = 9}), std::invalid_argument);
   CHECK_THROWS_AS(ti::Reconstructor({.background_fraction = 2}, {}), std::invalid_argument);
+  // The step factor: within +-1e6, so that heights and their gradients stay finite.
+  for (const double k : {1e300, -1e300, 1.000001e6, std::numeric_limits<double>::quiet_NaN(),
+                         std::numeric_limits<double>::infinity()}) {
+    CHECK_THROWS_WITH(ti::Reconstructor({.k = k}, {}),
+                      Catch::Contains("RecEdgedConfig::k must be in [-1e6, 1e6]"));
+  }
+  // At the bounds, on pixels at the largest magnitude segmentation accepts: finite heights,
+  // and a recogniser's hybrid features (gradient magnitudes of those heights) finite too.
+  ti::ImageD big = ti::ImageD::Zero(32, 32);
+  big.block(8, 4, 16, 24).setConstant(1e100);
+  big.block(12, 8, 8, 16).setConstant(0.5e100);
+  for (const double k : {1e6, -1e6}) {
+    for (const auto pp : {ti::PostProcess::none, ti::PostProcess::mean3x3}) {
+      ti::Reconstructor at_bound({.k = k, .background_fraction = 1.0, .postprocess = pp}, {}, 32,
+                                 32);
+      const ti::Segmentation bs = ti::segment(big, {.min_area = 0});
+      REQUIRE(bs.ok());
+      const ti::ImageD& heights = at_bound.rec_edged(bs);
+      CHECK(heights.allFinite());
+      CHECK(heights.cwiseAbs().maxCoeff() > 1e105);  // the steps were taken
+      ti::RecognizerConfig rc;
+      rc.segmentation.min_area = 0;
+      rc.edged = {.k = k, .background_fraction = 1.0, .postprocess = pp};
+      ti::Recognizer<> recognizer(32, 32, rc, ti::GradientThreshold{-1.0});  // always edged
+      const ti::Recognition& r = recognizer.recognize(big);
+      REQUIRE(r.ok());
+      CHECK(r.edged);
+      CHECK(r.hybrid.allFinite());
+    }
+  }
 }
 
 TEST_CASE("Recognizer: features, edged decision, no allocation per image", "[image]") {

@@ -26,7 +26,8 @@ enum class PostProcess { none, mean3x3, median3x3 };
 
 /// Options of RecEdged.
 struct RecEdgedConfig {
-  double k = 0.5;                    ///< step height factor: T1 = T2 = k * I2 (paper: unknown)
+  /// Step height factor: T1 = T2 = k * I2 (paper: unknown), in [-1e6, 1e6].
+  double k = 0.5;
   double background_fraction = 0.5;  ///< rows with more background than this are skipped
   /// false (the text): the surface rises when a row has more low- than high-pressure pixels;
   /// true: when it has more high- than low-pressure pixels (the physical reading).
@@ -37,7 +38,14 @@ struct RecEdgedConfig {
 
   /// Throws std::invalid_argument naming the bad field.
   void validate() const {
-    if (!std::isfinite(k)) throw std::invalid_argument("RecEdgedConfig::k must be finite");
+    // (Bounded so that the heights, k times pixel levels of at most 1e100, and their squared
+    // gradients stay finite: a k of 1e300 made the hybrid features infinite.)
+    if (!(std::abs(k) <= 1e6)) {
+      throw std::invalid_argument(
+          "RecEdgedConfig::k must be in [-1e6, 1e6] (steps of k times "
+          "the high-pressure level), got " +
+          std::to_string(k));
+    }
     if (!(background_fraction >= 0.0 && background_fraction <= 1.0)) {
       throw std::invalid_argument("RecEdgedConfig::background_fraction must be in [0, 1]");
     }
