@@ -42,8 +42,8 @@ struct RecEdgedConfig {
     // gradients stay finite: a k of 1e300 made the hybrid features infinite.)
     if (!(std::abs(k) <= 1e6)) {
       throw std::invalid_argument(
-          "RecEdgedConfig::k must be in [-1e6, 1e6] (steps of k times "
-          "the high-pressure level), got " +
+          "RecEdgedConfig::k must be in [-1e6, 1e6] (steps of k times the high-pressure level), "
+          "got " +
           std::to_string(k));
     }
     if (!(background_fraction >= 0.0 && background_fraction <= 1.0)) {
