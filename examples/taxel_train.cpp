@@ -3,10 +3,13 @@
 // output and model file, so it can stand in for LIBLINEAR's `train` (-s 1 and -s 3).
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -72,6 +75,18 @@ double number(std::string_view opt, std::string_view t) {
   return v;
 }
 
+// An integer option's value in [lo, hi]: digits only (no fraction, no exponent), so that a
+// value out of the option's type is refused, not converted.
+template <class T>
+T integer(std::string_view opt, std::string_view t, T lo, T hi, const char* what) {
+  T v{};
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (r.ec != std::errc{} || r.ptr != t.data() + t.size() || v < lo || v > hi) {
+    usage_error(std::string(opt) + " expects " + what + ", got '" + std::string(t) + "'");
+  }
+  return v;
+}
+
 std::string basename(const std::string& path) {
   const std::size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
@@ -108,9 +123,10 @@ int main(int argc, char** argv) {
         std::fputs(kUsage, stdout);
         return 0;
       } else if (a == "-s") {
-        const double s = number(a, value());
+        const std::string_view t = value();
+        const double s = number(a, t);
         if (s != 1.0 && s != 3.0)
-          usage_error("-s " + std::to_string(static_cast<int>(s)) +
+          usage_error("-s " + std::string(t) +
                       " is not supported: taxel-train has solvers 1 (L2-loss) and 3 (L1-loss)");
         cfg.loss = s == 1.0 ? tl::SvmLoss::l2 : tl::SvmLoss::l1;
       } else if (a == "-c") {
@@ -120,16 +136,15 @@ int main(int argc, char** argv) {
       } else if (a == "-B") {
         cfg.bias = number(a, value());
       } else if (a == "-v") {
-        const double v = number(a, value());
-        if (v < 2 || v != static_cast<int>(v))
-          usage_error("n-fold cross validation: n must be an integer >= 2");
-        folds = static_cast<int>(v);
+        folds = integer(a, value(), 2, 1 << 30, "the number of folds, an integer >= 2");
       } else if (a == "-q") {
         quiet = true;
       } else if (a == "--seed") {
-        cfg.seed = static_cast<std::uint64_t>(number(a, value()));
+        cfg.seed =
+            integer(a, value(), std::uint64_t{0}, ~std::uint64_t{0}, "an integer in [0, 2^64)");
       } else if (a == "--max-iter") {
-        cfg.max_iterations = static_cast<int>(number(a, value()));
+        cfg.max_iterations =
+            integer(a, value(), 1, std::numeric_limits<int>::max(), "an integer in [1, 2^31)");
       } else if (a == "--max-values") {
         const double v = number(a, value());
         if (!(v >= 1.0 && v <= 1e18)) usage_error("--max-values must be in [1, 1e18]");
@@ -184,6 +199,14 @@ int main(int argc, char** argv) {
     }
     const tl::Dataset data = taxel::io::parse_libsvm(taxel_cli::read_input(data_file),
                                                      taxel_cli::input_name(data_file), read_opt);
+    // A weight for a class the data does not have weighs nothing: say so, as LIBLINEAR does.
+    for (const auto& [label, weight] : cfg.class_weights) {
+      if (std::find(data.y.begin(), data.y.end(), label) == data.y.end()) {
+        std::fprintf(stderr,
+                     "taxel-train: warning: -w%d: %s has no class %d; the weight is unused\n",
+                     label, taxel_cli::input_name(data_file).c_str(), label);
+      }
+    }
     if (data_file == "-" && model_file.empty() && !search_c && folds == 0) {
       usage_error(
           "with the training set on standard input, name the model_file (- for "
