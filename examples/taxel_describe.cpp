@@ -100,17 +100,14 @@ Options parse(int argc, char** argv) {
       o.cfg.segmentation.polarity =
           v == "high" ? ti::Polarity::high_is_pressure : ti::Polarity::dark_is_pressure;
     } else if (a == "--k") {
-      o.cfg.segmentation.k =
-          args.number<int>(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+      o.cfg.segmentation.k = args.number<int>(2, 255);  // SegmentationConfig's range
     } else if (a == "--min-area") {
-      o.cfg.segmentation.min_area =
-          args.number<int>(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+      o.cfg.segmentation.min_area = args.number<int>(0, std::numeric_limits<int>::max());
     } else if (a == "--threshold") {
       o.threshold = args.number<double>(-std::numeric_limits<double>::infinity(),
                                         std::numeric_limits<double>::infinity());
     } else if (a == "--degree") {
-      o.cfg.edgeless.degree =
-          args.number<int>(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+      o.cfg.edgeless.degree = args.number<int>(0, 6);  // RecEdgelessConfig's range
     } else if (a == "--threads") {
       o.threads = args.number<unsigned>(0, 4096);
     } else if (a == "-o") {
