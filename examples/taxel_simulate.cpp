@@ -60,11 +60,11 @@ options:
   --touches T        palpation: touches (default 40)
   --pad RxC          tactel rows x columns (default 14x6)
   --pitch P          tactel pitch (default 0.0034)
-  --indentation D    how far pads press in (default 0.001)
+  --indentation D    how far pads press in, up to 1 m (default 0.001)
   --sigma-normal S   depth noise along the pad normal (default 0.0003)
   --sigma-position S kinematic translation noise (default 0.0002)
   --tilt T           kinematic rotation noise (default 0.02)
-  --frame-rate HZ    (default 1000)
+  --frame-rate HZ    up to 1e6 (default 1000)
   --seed S           (default 1)
   --truth-points N   samples of the true surface in TRUTH.ply (default 10000)
   --readings F.npy   also write the readings of the frames that gave the contacts

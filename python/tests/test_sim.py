@@ -50,6 +50,10 @@ def test_exploration_is_deterministic_and_placed():
     assert far["rms"] > 0.01
     with pytest.raises(ValueError, match="SlideParams"):
         sim.explore_sliding(sim.Sphere(), slides=0)
+    with pytest.raises(ValueError, match="more than a million frames"):
+        sim.explore_palpation(sim.Sphere(), touches=1, press_speed=1e-9)
+    with pytest.raises(ValueError, match="indentation must be in"):
+        sim.explore_sliding(sim.Sphere(), indentation=1.0e3)
     with pytest.raises(TypeError, match="shape"):
         sim.explore_sliding("sphere")
 

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <taxel/sim.hpp>
 
@@ -243,6 +244,34 @@ TEST_CASE("explorations and sensor model refuse bad parameters", "[sim][explorat
   CHECK_THROWS_AS(ts::explore_palpation(s, cfg, {.press_speed = 0}), std::invalid_argument);
   cfg.indentation = std::nan("");
   CHECK_THROWS_AS(ts::explore_sliding(s, cfg), std::invalid_argument);
+  // A length in millimetres given as metres, and frame rates beyond any tactile sensor's.
+  cfg.indentation = 1.5;
+  CHECK_THROWS_WITH(ts::explore_sliding(s, cfg),
+                    Catch::Contains("indentation must be in (0, 1] m"));
+  cfg = {};
+  for (const double rate : {0.0, 2e6, 1e300, std::numeric_limits<double>::infinity()}) {
+    cfg.frame_rate = rate;
+    CHECK_THROWS_WITH(ts::explore_palpation(s, cfg), Catch::Contains("frame_rate must be in"));
+  }
+  // Pressing in so slowly that it would take more than a million frames (at 1e-300 m/s the
+  // frame count overflowed an int, and at 1e-9 m/s the exploration ran for hours): refused
+  // before any frame, naming the parameters to change.
+  cfg = {};
+  for (const double speed : {1e-300, 1e-9}) {
+    CHECK_THROWS_WITH(ts::explore_palpation(s, cfg, {.touches = 1, .press_speed = speed}),
+                      Catch::Contains("PalpationParams: pressing") &&
+                          Catch::Contains("more than a million frames"));
+    CHECK_THROWS_WITH(ts::explore_grasps(s, cfg, {.grasps = 1, .closing_speed = speed}),
+                      Catch::Contains("GraspParams: pressing"));
+  }
+  CHECK_THROWS_WITH(ts::explore_palpation(s, cfg, {.hold_frames = 1000001}),
+                    Catch::Contains("hold_frames in [0, 1e6]"));
+  CHECK_THROWS_WITH(ts::explore_grasps(s, cfg, {.hold_frames = std::numeric_limits<int>::max()}),
+                    Catch::Contains("hold_frames in [0, 1e6]"));
+  // A press within the bound: 1 mm at 0.01 m/s and 1 kHz is 100 frames, and the two before.
+  const ts::Exploration<ts::Sphere> quick =
+      ts::explore_palpation(s, cfg, {.touches = 1, .press_speed = 0.01, .hold_frames = 0});
+  CHECK(quick.frames.size() == 102);
   cfg = {};
   cfg.sensor.geometry.pitch = -1;
   CHECK_THROWS_WITH(ts::explore_palpation(s, cfg), Catch::Contains("pitch"));

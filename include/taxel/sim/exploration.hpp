@@ -28,8 +28,8 @@ namespace taxel::sim {
 struct ExplorationConfig {
   SensorModel sensor;                 ///< the pads (all pads of a hand are alike)
   sensor::ContactOptions contacts{};  ///< how readings become contacts (per tactel or per pad)
-  double frame_rate = 1000.0;         ///< frames per second [Hz], > 0
-  double indentation = 1.0e-3;        ///< how far a pad presses into the object [m], > 0
+  double frame_rate = 1000.0;         ///< frames per second [Hz], in (0, 1e6]
+  double indentation = 1.0e-3;        ///< how far a pad presses into the object [m], in (0, 1]
   Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  ///< shape frame -> world
   std::uint64_t seed = 1;                                         ///< equal seeds, equal output
 
@@ -38,10 +38,13 @@ struct ExplorationConfig {
   void validate() const {
     sensor.validate();
     contacts.validate();
-    if (!(frame_rate > 0) || !std::isfinite(frame_rate))
-      throw std::invalid_argument("ExplorationConfig: frame_rate must be finite and > 0");
-    if (!(indentation > 0) || !std::isfinite(indentation))
-      throw std::invalid_argument("ExplorationConfig: indentation must be finite and > 0");
+    if (!(frame_rate > 0) || !(frame_rate <= 1e6))
+      throw std::invalid_argument("ExplorationConfig: frame_rate must be in (0, 1e6] Hz");
+    if (!(indentation > 0) || !(indentation <= 1.0)) {
+      throw std::invalid_argument(
+          "ExplorationConfig: indentation must be in (0, 1] m (a length in millimetres given as "
+          "metres?)");
+    }
     if (!object_pose.matrix().allFinite())
       throw std::invalid_argument("ExplorationConfig: object_pose must be finite");
   }
@@ -96,7 +99,7 @@ struct GraspParams {
   int pads_per_finger = 2;      ///< proximal and distal, >= 1
   double pad_spacing = 0.05;    ///< distance of the pads along a finger [m], >= 0
   double closing_speed = 0.05;  ///< [m/s], > 0
-  int hold_frames = 50;         ///< >= 0
+  int hold_frames = 50;         ///< in [0, 1e6]
 };
 
 /// Palpation: one pad pokes the surface at uniformly random points, its face tangent there,
@@ -104,7 +107,7 @@ struct GraspParams {
 struct PalpationParams {
   int touches = 40;           ///< >= 1
   double press_speed = 0.02;  ///< [m/s], > 0
-  int hold_frames = 10;       ///< >= 0
+  int hold_frames = 10;       ///< in [0, 1e6]
 };
 
 namespace detail {
@@ -129,6 +132,20 @@ Vec3d random_unit(Rng& rng) {
   Vec3d d(g(rng), g(rng), g(rng));
   while (d.squaredNorm() < 1e-24) d = Vec3d(g(rng), g(rng), g(rng));
   return d.normalized();
+}
+
+/// The frames a pad takes to move `distance` [m] at `step` [m] per frame, rounded up; throws
+/// std::invalid_argument naming `what` (the speed's parameter) beyond a million frames, which
+/// no exploration needs and which would run for hours (a speed of 1e-300 m/s would not end).
+inline int frames_to_cover(double distance, double step, const char* what) {
+  const double n = std::ceil(distance / step);
+  if (!(n <= 1e6)) {
+    throw std::invalid_argument(std::string(what) + ": pressing " + std::to_string(distance) +
+                                " m in at " + std::to_string(step) +
+                                " m per frame takes more than a million frames; raise the speed "
+                                "or lower ExplorationConfig::frame_rate");
+  }
+  return static_cast<int>(n);
 }
 
 /// Smallest signed distance of a pad's tactels to the shape (negative: some tactel is inside).
@@ -201,10 +218,11 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
   cfg.validate();
   if (p.grasps < 1 || p.fingers < 1 || p.pads_per_finger < 1 || p.fingers > 64 ||
       p.pads_per_finger > 64 || !(p.pad_spacing >= 0) || !std::isfinite(p.pad_spacing) ||
-      !(p.closing_speed > 0) || !std::isfinite(p.closing_speed) || p.hold_frames < 0) {
+      !(p.closing_speed > 0) || !std::isfinite(p.closing_speed) || p.hold_frames < 0 ||
+      p.hold_frames > 1000000) {
     throw std::invalid_argument(
         "GraspParams: grasps >= 1, fingers and pads_per_finger in [1, 64], pad_spacing >= 0, "
-        "closing_speed > 0 and hold_frames >= 0");
+        "closing_speed > 0 and hold_frames in [0, 1e6]");
   }
   Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
   const Posed<Sh>& world = ex.truth;
@@ -264,7 +282,7 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
     }
     if (std::none_of(pads.begin(), pads.end(), [](const Pad& q) { return q.touch >= 0.0; }))
       continue;
-    const int closing = static_cast<int>(std::ceil(cfg.indentation / step)) + 2;
+    const int closing = detail::frames_to_cover(cfg.indentation, step, "GraspParams") + 2;
     for (int f = 0; f < closing + p.hold_frames; ++f, ++tick) {
       const double s_rel = std::min(double(f - 2) * step, cfg.indentation);
       std::vector<PadReading> readings;
@@ -287,16 +305,17 @@ template <SampleableShape Sh>
 Exploration<Sh> explore_palpation(const Sh& shape, const ExplorationConfig& cfg,
                                   const PalpationParams& p = {}) {
   cfg.validate();
-  if (p.touches < 1 || !(p.press_speed > 0) || !std::isfinite(p.press_speed) || p.hold_frames < 0) {
+  if (p.touches < 1 || !(p.press_speed > 0) || !std::isfinite(p.press_speed) || p.hold_frames < 0 ||
+      p.hold_frames > 1000000) {
     throw std::invalid_argument(
-        "PalpationParams: touches >= 1, press_speed > 0 and hold_frames >= 0");
+        "PalpationParams: touches >= 1, press_speed > 0 and hold_frames in [0, 1e6]");
   }
   Exploration<Sh> ex{Posed<Sh>{shape, cfg.object_pose}, {}};
   const Posed<Sh>& world = ex.truth;
   sensor::ContactExtractor extractor(cfg.sensor, cfg.contacts);
   std::mt19937_64 rng(cfg.seed);
   const double step = p.press_speed / cfg.frame_rate;
-  const int pressing = static_cast<int>(std::ceil(cfg.indentation / step)) + 2;
+  const int pressing = detail::frames_to_cover(cfg.indentation, step, "PalpationParams") + 2;
   std::size_t tick = 0;
   for (int k = 0; k < p.touches; ++k) {
     Vec3d at, n;
