@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -134,16 +135,19 @@ Vec3d random_unit(Rng& rng) {
   return d.normalized();
 }
 
-/// The frames a pad takes to move `distance` [m] at `step` [m] per frame, rounded up; throws
-/// std::invalid_argument naming `what` (the speed's parameter) beyond a million frames, which
-/// no exploration needs and which would run for hours (a speed of 1e-300 m/s would not end).
-inline int frames_to_cover(double distance, double step, const char* what) {
-  const double n = std::ceil(distance / step);
+/// The frames a pad takes to press `distance` [m] in at `speed` [m/s] and `frame_rate` [Hz],
+/// rounded up; throws std::invalid_argument naming `what` (the speed's parameter) beyond a
+/// million frames, which no exploration needs and which would run for hours (a speed of
+/// 1e-300 m/s would not end).
+inline int frames_to_press(double distance, double speed, double frame_rate, const char* what) {
+  const double n = std::ceil(distance / (speed / frame_rate));
   if (!(n <= 1e6)) {
-    throw std::invalid_argument(std::string(what) + ": pressing " + std::to_string(distance) +
-                                " m in at " + std::to_string(step) +
-                                " m per frame takes more than a million frames; raise the speed "
-                                "or lower ExplorationConfig::frame_rate");
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "%s: pressing %.3g m in at %.3g m/s and %.3g Hz takes more than a million "
+                  "frames; raise the speed or lower ExplorationConfig::frame_rate",
+                  what, distance, speed, frame_rate);
+    throw std::invalid_argument(text);
   }
   return static_cast<int>(n);
 }
@@ -239,6 +243,8 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
   const double start = 1.2 * reach + cfg.indentation + 2e-3;  // pads start clear of the object
   const double scan = std::min(0.5 * g.pitch, 0.25 * reach);  // finer than any pad feature
   const double step = p.closing_speed / cfg.frame_rate;
+  const int closing =
+      detail::frames_to_press(cfg.indentation, p.closing_speed, cfg.frame_rate, "GraspParams") + 2;
 
   std::mt19937_64 rng(cfg.seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -282,7 +288,6 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
     }
     if (std::none_of(pads.begin(), pads.end(), [](const Pad& q) { return q.touch >= 0.0; }))
       continue;
-    const int closing = detail::frames_to_cover(cfg.indentation, step, "GraspParams") + 2;
     for (int f = 0; f < closing + p.hold_frames; ++f, ++tick) {
       const double s_rel = std::min(double(f - 2) * step, cfg.indentation);
       std::vector<PadReading> readings;
@@ -315,7 +320,9 @@ Exploration<Sh> explore_palpation(const Sh& shape, const ExplorationConfig& cfg,
   sensor::ContactExtractor extractor(cfg.sensor, cfg.contacts);
   std::mt19937_64 rng(cfg.seed);
   const double step = p.press_speed / cfg.frame_rate;
-  const int pressing = detail::frames_to_cover(cfg.indentation, step, "PalpationParams") + 2;
+  const int pressing =
+      detail::frames_to_press(cfg.indentation, p.press_speed, cfg.frame_rate, "PalpationParams") +
+      2;
   std::size_t tick = 0;
   for (int k = 0; k < p.touches; ++k) {
     Vec3d at, n;
