@@ -7,6 +7,7 @@
 #include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <random>
 #include <taxel/sensor.hpp>
@@ -504,6 +505,46 @@ TEST_CASE("readings to contacts: per pad, a light touch gives its tactels one by
     CHECK(by_pad[i].position == by_tactel[i].position);
     CHECK(std::abs((by_pad[i].position - centre).norm() - R) < 5e-6);
   }
+}
+
+TEST_CASE("readings to contacts: per pad, a quadric that does not fit gives the tactels one by one",
+          "[sensor]") {
+  // A pad with little depth noise (0.02 mm, so that the fit test is sharp) pressed across a
+  // ridge along its x axis, deep enough for five or six rows of active tactels: an edge between
+  // two faces of slope 0.2, and a 15 mm tube (a torus's cross-section). A quadric in the pad
+  // plane follows neither, and its point above the centroid would lie off the surface; the
+  // tactels' own contacts lie on it. A 40 mm sphere pressed 1.5 mm still gives its one
+  // contact.
+  tsn::SensorModel m = noiseless();
+  m.sigma_normal = 0.02e-3;
+  tsn::ContactExtractor pad(m, {.mode = tsn::ContactMode::per_pad});
+  tsn::ContactExtractor tactel(m, {.mode = tsn::ContactMode::per_tactel});
+  const double y0 = m.geometry.tactel(6, 0).y() + 0.3e-3;  // off the tactel rows
+  const auto edge = [&](double, double y) { return 2.2e-3 - 0.2 * std::abs(y - y0); };
+  const double R = 0.015;
+  const auto tube = [&](double, double y) {
+    const double dy = std::min(std::abs(y - y0), R);
+    return 4e-3 - (R - std::sqrt(R * R - dy * dy));
+  };
+  for (const std::function<double(double, double)>& depth : {std::function(edge), {tube}}) {
+    const tsn::PadMatrix counts = readings(m, depth);
+    std::vector<taxel::Contact<double>> by_pad, by_tactel;
+    const std::size_t n = tactel.extract(counts, Eigen::Isometry3d::Identity(), 0, by_tactel);
+    REQUIRE(n >= 24);
+    REQUIRE(pad.extract(counts, Eigen::Isometry3d::Identity(), 0, by_pad) == n);
+    for (std::size_t i = 0; i < n; ++i) {
+      CHECK(by_pad[i].position == by_tactel[i].position);
+      const Vec3d& p = by_pad[i].position;
+      CHECK(std::abs(-p.z() - depth(p.x(), p.y())) < 2e-6);
+    }
+  }
+  const double S = 0.04;
+  const auto sphere = [&](double x, double y) {
+    const double dy = y - y0;
+    return 1.5e-3 - (S - std::sqrt(S * S - x * x - dy * dy));
+  };
+  std::vector<taxel::Contact<double>> one;
+  CHECK(pad.extract(readings(m, sphere), Eigen::Isometry3d::Identity(), 0, one) == 1);
 }
 
 TEST_CASE("readings to contacts: per pad, unbiased on a small sphere under noise", "[sensor]") {
