@@ -74,7 +74,8 @@ options:
                     for a CSV in millimetres (CONTACTS.csv only)
 readings (--readings, --session):
   --per-pad         one contact per pad and frame (default: one per active tactel; a frame
-                    with under six active tactels gives one per tactel)
+                    with under six active tactels, or whose depths the frame's quadric does
+                    not fit, gives one per tactel)
   --pitch P         tactel pitch [m] (default 0.0034; --readings only)
   --levels L        reading levels, e.g. 4096 for 12 bits (default 4096; --readings only)
   --full-scale-depth D   indentation at the largest reading [m] (default 0.003)

@@ -51,7 +51,8 @@ options:
   --contacts N       stop after N contacts, exploring further as needed (default 20000;
                      0: exactly the exploration below)
   --per-pad          one contact per pad and frame (a quadric fitted to its depth map; one per
-                     tactel when under six are active), not one per tactel
+                     tactel when under six are active or the quadric does not fit them), not
+                     one per tactel
   --slides K         sliding: slides from random starts (default 4)
   --frames F         sliding: frames per slide (default 1000)
   --speed V          sliding speed [m/s] (default 0.05)

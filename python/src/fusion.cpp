@@ -320,7 +320,7 @@ sigma_tilt [rad] are the per-frame noise of the pad pose. Defaults: a Weiss DSA 
   py::class_<sensor::ContactOptions>(s, "ContactOptions", R"doc(
 How readings become contacts: `mode` 'per_tactel' (a contact per active tactel) or 'per_pad'
 (one per pad and frame, from a quadric fitted to its depth map; one per tactel in a frame with
-fewer than six active); `local_normals` (normals from the pad's depth map, else the pad normal, stated as unmeasured); `correct_censoring`
+fewer than six active, or whose depths the quadric does not fit); `local_normals` (normals from the pad's depth map, else the pad normal, stated as unmeasured); `correct_censoring`
 (remove the bias of readings that barely passed the noise floor); `fallback_normal_sigma`
 [rad], the slope uncertainty where the depth map cannot measure it; `refine_censoring` (evaluate
 that correction at the depth a quadric fitted to the pad predicts, unbiased at the rim of a

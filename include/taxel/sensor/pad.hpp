@@ -75,7 +75,8 @@ using PadMatrix = Eigen::Array<std::uint16_t, Eigen::Dynamic, Eigen::Dynamic, Ei
 
 /// Contacts from a reading: one per active tactel, or one per pad and frame (from a quadric
 /// fitted to the pad's depth map; a frame whose active tactels do not determine a quadric, fewer
-/// than six or in one or two rows, gives one per active tactel).
+/// than six or in one or two rows, or whose depths the quadric does not fit, gives one per
+/// active tactel).
 enum class ContactMode { per_tactel, per_pad };
 
 }  // namespace taxel::sensor
