@@ -5,6 +5,8 @@
 // CSV).
 #pragma once
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -15,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <initializer_list>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -22,6 +25,7 @@
 #include <taxel/io/file.hpp>
 #include <taxel/version.hpp>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace taxel_cli {
@@ -131,11 +135,27 @@ inline bool parse_length(std::string_view text, double& metres) {
   return true;
 }
 
-/// True when the paths `a` and `b` name the same file: an existing one (hard or symbolic links
-/// included), or the same path once made absolute and resolved ("./x" and "x"). Standard
-/// streams ("-") and empty names are no files.
-inline bool same_file(std::string_view a, std::string_view b) {
-  if (a.empty() || b.empty() || a == "-" || b == "-") return false;
+/// The device and inode of the file a tool's argument opens, when it is a regular file: "-"
+/// is the standard stream `std_fd` (0 for an input, 1 for an output); a path is followed
+/// through symbolic links, so /dev/stdin, /dev/fd/0 and /proc/self/fd/0 are the file the
+/// shell redirected. Nothing for a missing file, a pipe, a terminal or a device.
+inline std::optional<std::pair<dev_t, ino_t>> regular_file_id(std::string_view path,
+                                                              int std_fd) {
+  struct ::stat st {};
+  const int rc = path == "-" ? ::fstat(std_fd, &st) : ::stat(std::string(path).c_str(), &st);
+  if (rc != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  return std::pair{st.st_dev, st.st_ino};
+}
+
+/// True when the arguments `a` and `b` name the same file: the same regular file opened (hard
+/// or symbolic links, /dev/stdin, and "-" as the standard stream `a_fd` or `b_fd` included),
+/// or the same path once made absolute and resolved ("./x" and "x", for outputs that do not
+/// exist yet). Empty names are no files.
+inline bool same_file(std::string_view a, std::string_view b, int a_fd = 0, int b_fd = 0) {
+  if (a.empty() || b.empty()) return false;
+  const auto ia = regular_file_id(a, a_fd), ib = regular_file_id(b, b_fd);
+  if (ia && ib) return *ia == *ib;
+  if (a == "-" || b == "-") return false;
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path pa(a), pb(b);
@@ -146,20 +166,21 @@ inline bool same_file(std::string_view a, std::string_view b) {
   return !ec && ca == cb;
 }
 
-/// Why the output file `output` cannot be written, or "" when it can: it is one of `inputs`
-/// or of `other_outputs` (same_file). A tool writes its outputs after reading its inputs, so it
-/// would replace an input with its result, or one output with another.
+/// Why the output `output` cannot be written, or "" when it can: it is one of `inputs` or of `other_outputs` (same_file; "-" is standard input among the inputs
+/// and standard output among the outputs). A tool writes its outputs after reading its inputs,
+/// so it would replace an input with its result, or one output with another.
 template <class Inputs = std::initializer_list<std::string_view>>
 std::string output_conflict(std::string_view output, const Inputs& inputs,
                             std::initializer_list<std::string_view> other_outputs = {}) {
   for (const auto& in : inputs) {
-    if (same_file(output, in)) {
-      return "the output '" + std::string(output) + "' is the input '" + std::string(in) +
+    if (same_file(output, in, 1, 0)) {
+      return "the output '" + std::string(output) + "' is the input '" +
+             std::string(in == "-" ? "<stdin>" : in) +
              "': writing it would replace the input; name another output";
     }
   }
   for (const std::string_view other : other_outputs) {
-    if (same_file(output, other)) {
+    if (!other.empty() && other != "-" && output != "-" && same_file(output, other, 1, 1)) {
       return "the outputs '" + std::string(output) + "' and '" + std::string(other) +
              "' are the same file; name two different files";
     }
@@ -178,6 +199,7 @@ class Args {
     if (inline_value_) fail(std::string(current_) + " takes no value");
     if (i_ + 1 >= argc_) return false;
     arg = current_ = argv_[++i_];
+    if (arg.empty()) fail("argument " + std::to_string(i_) + " is empty: name a file");
     if (arg.size() > 2 && arg.substr(0, 2) == "--") {
       if (const auto eq = arg.find('='); eq != std::string_view::npos) {
         inline_value_ = arg.substr(eq + 1);
@@ -188,15 +210,11 @@ class Args {
   }
 
   /// The value of the current option (after '=', or the next argument); fails when there is
-  /// none.
+  /// none or it is empty (every value is a file name, a number or a word).
   std::string_view value() {
-    if (inline_value_) {
-      const std::string_view v = *inline_value_;
-      inline_value_.reset();
-      return v;
-    }
-    if (i_ + 1 >= argc_) fail(std::string(current_) + " needs a value");
-    return argv_[++i_];
+    const std::string_view v = next_value();
+    if (v.empty()) fail(std::string(current_) + " needs a value, not an empty string");
+    return v;
   }
 
   /// The current option's value as a number of type T in [lo, hi].
@@ -251,6 +269,15 @@ class Args {
   }
 
  private:
+  std::string_view next_value() {
+    if (inline_value_) {
+      const std::string_view v = *inline_value_;
+      inline_value_.reset();
+      return v;
+    }
+    if (i_ + 1 >= argc_) fail(std::string(current_) + " needs a value");
+    return argv_[++i_];
+  }
   template <class T>
   static std::string range(T lo, T hi) {
     if constexpr (std::is_floating_point_v<T>) {
@@ -270,8 +297,10 @@ class Args {
         return std::to_string(v);
       }
     };
-    std::string out = "[";
-    out.append(one(lo)).append(", ").append(one(hi)).append("]");
+    // The least positive double as a lower bound reads as an open interval from 0.
+    const bool open = std::is_floating_point_v<T> && lo == std::numeric_limits<T>::min();
+    std::string out = open ? "(0" : "[" + one(lo);
+    out.append(", ").append(one(hi)).append("]");
     return out;
   }
 
@@ -331,6 +360,38 @@ inline void write_output(const std::string& path, std::string_view bytes) {
   } else {
     taxel::io::write_file(path, bytes);
   }
+}
+
+/// Writes outputs that belong together as a set (taxel::io::write_files): every file is
+/// written before any replaces its previous version, so a failure leaves all of them as they
+/// were. An output "-" goes to standard output after the files are in place.
+inline void write_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  std::vector<taxel::io::FileContent> files;
+  for (const auto& [path, bytes] : outputs) {
+    if (path != "-") files.push_back({path, bytes});
+  }
+  taxel::io::write_files(files);
+  for (const auto& [path, bytes] : outputs) {
+    if (path == "-") write_output(path, bytes);
+  }
+}
+
+/// `s` with control characters (a NUL, an escape, a line break) shown as \\xNN, so that text
+/// from a file cannot cut or garble a one-line message.
+inline std::string printable(std::string_view s) {
+  std::string out;
+  out.reserve(s.size());
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", u);
+      out += buf;
+    } else {
+      out.push_back(c);
+    }
+  }
+  return out;
 }
 
 /// `s` with quotes and backslashes escaped and control characters blanked, for JSON strings.

@@ -593,10 +593,13 @@ void session_section(const fs::path& out, Page& page) {
 #if defined(TAXEL_DEMO_HAVE_DRIVERS)
   namespace td = taxel::drivers;
   const std::string dir = TAXEL_SESSION_DIR;
-  const auto poses = taxel_drivers_cli::read_poses_csv(dir + "/cylinder_grasp_poses.csv");
   td::DsaconDevice dev(td::ReplayTransport::from_file(dir + "/cylinder_grasp.session"),
-                       {.frame_timeout = td::Timeout(50)});
+                       {.reply_timeout = td::Timeout(50), .frame_timeout = td::Timeout(50)});
   dev.open();
+  const std::string poses_file = dir + "/cylinder_grasp_poses.csv";
+  const td::SessionPoses table(io::read_file(poses_file), poses_file, dev.matrices().size());
+  const std::vector<Eigen::Isometry3d> fixed = td::static_matrix_poses(dev.matrices());
+  std::vector<Eigen::Isometry3d> poses;
   dev.start();
   tf::ContactCloud<tf::Kalman<double>> cloud({.association_radius = 4e-3});
   std::vector<Contact<double>> contacts;
@@ -605,10 +608,9 @@ void session_section(const fs::path& out, Page& page) {
   std::size_t busiest_contacts = 0;
   while (auto f = dev.read_frame()) {
     ++frames;
-    const auto it = poses.find(f->device_time_ms);
-    if (it == poses.end()) continue;
+    if (!table.frame_poses(*f, fixed, td::PadCalibration{}.threshold, poses_file, poses)) continue;
     contacts.clear();
-    td::frame_contacts(*f, dev.matrices(), it->second, contacts);
+    td::frame_contacts(*f, dev.matrices(), poses, contacts);
     (void)cloud.insert(std::span<const Contact<double>>(contacts));
     total += contacts.size();
     if (contacts.size() > busiest_contacts) {  // picture of the frame with the most contact

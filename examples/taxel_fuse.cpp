@@ -2,11 +2,16 @@
 // taxel-fuse: a contact stream (CSV) in, the fused cloud (PLY) out, with the fusion policy and
 // the spatial index chosen by option.
 #include <chrono>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <map>
+#include <numbers>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <taxel/fusion.hpp>
@@ -137,31 +142,45 @@ void print_summary(const Options& o) {
   std::fwrite(text.data(), 1, text.size(), o.files[1] == "-" ? stderr : stdout);
 }
 
+// Where the contacts come from: fills `batch` (cleared first) with the next contacts and returns
+// false once the input is used up. A CSV is read a batch at a time, so that a stream of any
+// length is fused in memory that depends on the cloud, not on the file.
+using Feed = std::function<bool(std::vector<taxel::Contact<double>>&)>;
+
 template <class Cloud>
-int fuse(const Options& o, typename Cloud::Config cfg,
-         const std::vector<taxel::Contact<double>>& contacts, const taxel_cli::Args& args) {
+int fuse(const Options& o, typename Cloud::Config cfg, const Feed& feed,
+         const taxel_cli::Args& args) {
   cfg.association_radius = o.radius;
   cfg.association_sigmas = o.association_sigmas;
   Cloud cloud(cfg);
-  cloud.reserve(contacts.size());
   std::map<std::string, std::size_t> rejected;
-  std::size_t added = 0, fused = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (const auto& c : contacts) {
-    const auto r = cloud.insert(c);
-    switch (r.status) {
-      case taxel::fusion::InsertStatus::added:
-        ++added;
-        break;
-      case taxel::fusion::InsertStatus::fused:
-        ++fused;
-        break;
-      default:
-        ++rejected[std::string(taxel::to_string(r.defect))];
+  std::size_t contacts = 0, added = 0, fused = 0;
+  double s = 0.0;  // seconds spent inserting
+  std::vector<taxel::Contact<double>> batch;
+  for (bool more = true; more;) {
+    try {
+      more = feed(batch);
+    } catch (const std::exception& e) {
+      args.fail(e.what(), 1);
     }
+    contacts += batch.size();
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const auto& c : batch) {
+      const auto r = cloud.insert(c);
+      switch (r.status) {
+        case taxel::fusion::InsertStatus::added:
+          ++added;
+          break;
+        case taxel::fusion::InsertStatus::fused:
+          ++fused;
+          break;
+        default:
+          ++rejected[std::string(taxel::to_string(r.defect))];
+      }
+    }
+    s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  summary["contacts"] = contacts.size();
+  summary["contacts"] = contacts;
   summary["added"] = added;
   summary["fused"] = fused;
   std::size_t total_rejected = 0;
@@ -175,7 +194,19 @@ int fuse(const Options& o, typename Cloud::Config cfg,
   summary["skipped_rows"] = skipped_rows;
   summary["points"] = cloud.size();
   summary["ns_per_contact"] =
-      std::llround(contacts.empty() ? 0.0 : 1e9 * s / static_cast<double>(contacts.size()));
+      std::llround(contacts == 0 ? 0.0 : 1e9 * s / static_cast<double>(contacts));
+  if (contacts > 0 && total_rejected == contacts) {
+    // Nothing to write is a failed run, not an empty success (a --scale or --radius far off
+    // makes every contact out of range).
+    const bool range = rejected.count(std::string(taxel::to_string(
+                           taxel::ContactDefect::out_of_range))) > 0;
+    args.fail("every one of the " + std::to_string(contacts) + " contacts was rejected (" +
+                  rejected.begin()->first + (rejected.size() > 1 ? ", ..." : "") + ")" +
+                  (range ? "; the index's range shrinks with --radius: check --radius and --scale"
+                         : "") +
+                  "; no cloud written",
+              1);
+  }
   if (o.policy != "raw" && fused == 0 && added >= 100) {  // raw never fuses
     std::fprintf(stderr,
                  "taxel-fuse: warning: no contact fused with another: the association radius "
@@ -198,73 +229,73 @@ int fuse(const Options& o, typename Cloud::Config cfg,
 }
 
 template <class Policy>
-int with_index(const Options& o, typename Policy::Config pc,
-               const std::vector<taxel::Contact<double>>& contacts, const taxel_cli::Args& args) {
+int with_index(const Options& o, typename Policy::Config pc, const Feed& feed,
+               const taxel_cli::Args& args) {
   namespace tf = taxel::fusion;
   namespace ti = taxel::index;
   if (o.index == "kd-tree") {
     typename tf::ContactCloud<Policy, ti::DynamicKdTree<double>>::Config cfg;
     cfg.fusion = pc;
-    return fuse<tf::ContactCloud<Policy, ti::DynamicKdTree<double>>>(o, cfg, contacts, args);
+    return fuse<tf::ContactCloud<Policy, ti::DynamicKdTree<double>>>(o, cfg, feed, args);
   }
   if (o.index == "brute-force") {
     typename tf::ContactCloud<Policy, ti::BruteForce<double>>::Config cfg;
     cfg.fusion = pc;
-    return fuse<tf::ContactCloud<Policy, ti::BruteForce<double>>>(o, cfg, contacts, args);
+    return fuse<tf::ContactCloud<Policy, ti::BruteForce<double>>>(o, cfg, feed, args);
   }
   typename tf::ContactCloud<Policy, ti::VoxelHash<double>>::Config cfg;
   cfg.fusion = pc;
-  return fuse<tf::ContactCloud<Policy, ti::VoxelHash<double>>>(o, cfg, contacts, args);
+  return fuse<tf::ContactCloud<Policy, ti::VoxelHash<double>>>(o, cfg, feed, args);
 }
 
 // The contacts of a recorded DSACON32m session: each frame's matrices at the poses of the frame's
 // time stamp in POSES.csv (as taxel-record --poses writes them), else at the controller's static
-// matrix poses. Throws on a malformed file or a replay that fails.
-// Returns why the replay fell short of the whole recording ("" when it did not).
+// matrix poses. Throws on a malformed file, a pose file that does not fit the session, or a
+// replay that fails. Returns why the replay fell short of the whole recording ("" when it did
+// not).
 std::string session_contacts(const Options& o, const taxel::sensor::ContactOptions& copt,
                              std::vector<taxel::Contact<double>>& out) {
   namespace td = taxel::drivers;
-  std::map<std::uint32_t, std::vector<Eigen::Isometry3d>> by_time;
-  if (!o.poses.empty()) {
-    const std::string text = taxel_cli::read_input(o.poses);
-    for (const auto& p : taxel::io::parse_pad_poses_csv(text, taxel_cli::input_name(o.poses))) {
-      auto& v = by_time[static_cast<std::uint32_t>(std::lround(p.time * 1e3))];
-      if (v.size() <= p.pad) v.resize(p.pad + 1, Eigen::Isometry3d::Identity());
-      v[p.pad] = p.pose;
-    }
-  }
   td::SessionPrefix file = td::read_session_prefix(o.session);
   if (file.chunks.empty() && !file.error.empty()) throw td::SessionError(file.error);
+  // A replay answers at once or never: waiting on it only delays the message.
   td::DsaconDevice dev(td::ReplayTransport(std::move(file.chunks)),
-                       {.frame_timeout = td::Timeout(50)});
+                       {.reply_timeout = td::Timeout(50), .frame_timeout = td::Timeout(50)});
   try {
     dev.open();
-  } catch (const std::exception& e) {  // the damage may lie in the handshake itself
-    if (file.error.empty()) throw;
-    throw std::runtime_error(std::string(e.what()) + "; " + file.error);
+    dev.start();
+  } catch (const std::exception& e) {  // the damage lies in the handshake itself
+    const std::uint64_t line = dev.transport().last_read_line();
+    throw std::runtime_error(
+        o.session + ": the recorded handshake fails: " + e.what() +
+        (line > 0 ? " (the device's bytes read last are on line " + std::to_string(line) + ")"
+                  : std::string()) +
+        (file.error.empty() ? std::string() : "; " + file.error));
   }
   const std::vector<Eigen::Isometry3d> fixed = td::static_matrix_poses(dev.matrices());
+  td::SessionPoses table;
+  if (!o.poses.empty()) {
+    table = td::SessionPoses(taxel_cli::read_input(o.poses), taxel_cli::input_name(o.poses),
+                             dev.matrices().size());
+  }
   td::PadCalibration cal;
   cal.full_scale_depth = o.model.full_scale_depth;
   cal.threshold = o.model.threshold;
   cal.sigma_normal = o.model.sigma_normal;
   cal.sigma_position = o.model.sigma_position;
   cal.sigma_tilt = o.model.sigma_tilt;
-  dev.start();
   std::size_t frames = 0, posed = 0;
+  std::vector<Eigen::Isometry3d> poses;
   while (const auto f = dev.read_frame()) {
     ++frames;
-    const auto it = by_time.find(f->device_time_ms);
-    const bool have = it != by_time.end() && it->second.size() == dev.matrices().size();
-    posed += have ? 1 : 0;
-    td::frame_contacts(*f, dev.matrices(), have ? it->second : fixed, out, copt.mode, cal, copt);
+    if (table.frame_poses(*f, fixed, cal.threshold, taxel_cli::input_name(o.poses), poses)) {
+      ++posed;
+    }
+    td::frame_contacts(*f, dev.matrices(), poses, out, copt.mode, cal, copt);
   }
-  // Checked before close(), whose stop command the recording may not hold.
-  const std::string shortfall =
-      td::replay_shortfall(dev.transport(), dev.unparsed_bytes(), file.error);
-  dev.close();
-  summary["session"] = {
-      {"frames", frames}, {"frames_with_poses", posed}, {"matrices", dev.matrices().size()}};
+  const std::size_t matrices = dev.matrices().size();
+  const std::string shortfall = td::finish_replay(dev, file.error);
+  summary["session"] = {{"frames", frames}, {"frames_with_poses", posed}, {"matrices", matrices}};
   return shortfall;
 }
 
@@ -275,6 +306,7 @@ int main(int argc, char** argv) {
   taxel_cli::print_version_if_asked("taxel-fuse", argc, argv);
   taxel_cli::Args args("taxel-fuse", argc, argv);
   constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kTiny = std::numeric_limits<double>::min();  // the least positive value
   Options o;
   std::string_view a;
   while (args.next(a)) {
@@ -321,21 +353,22 @@ int main(int argc, char** argv) {
     } else if (a == "--per-pad") {
       o.per_pad = true;
     } else if (a == "--pitch") {
-      o.model.geometry.pitch = args.length(0.0, kInf);
+      o.model.geometry.pitch = args.length(1e-6, 1.0);  // SensorModel's ranges, checked here
+                                                        // before any input is read
     } else if (a == "--levels") {
       o.model.levels = args.number<int>(2, 65536);
     } else if (a == "--full-scale-depth") {
-      o.model.full_scale_depth = args.length(0.0, kInf);
+      o.model.full_scale_depth = args.length(kTiny, 1.0);
     } else if (a == "--threshold") {
       o.model.threshold = args.number<int>(1, 65535);
     } else if (a == "--sigma-normal") {
-      o.model.sigma_normal = args.length(0.0, kInf);
+      o.model.sigma_normal = args.length(0.0, 1.0);
     } else if (a == "--sigma-position") {
-      o.model.sigma_position = args.length(0.0, kInf);
+      o.model.sigma_position = args.length(0.0, 1.0);
     } else if (a == "--sigma-tilt") {
-      o.model.sigma_tilt = args.number<double>(0.0, kInf);
+      o.model.sigma_tilt = args.number<double>(0.0, std::numbers::pi);
     } else if (a == "--frame-rate") {
-      o.frame_rate = args.number<double>(0.0, kInf);
+      o.frame_rate = args.number<double>(kTiny, std::numeric_limits<double>::max());
     } else if (a == "--format") {
       o.format = taxel_cli::to_format(args.choice("text|json|csv"));
     } else if (a.size() > 1 && a[0] == '-') {
@@ -343,6 +376,10 @@ int main(int argc, char** argv) {
     } else {
       o.files.emplace_back(a);
     }
+  }
+  if (o.model.threshold >= o.model.levels) {
+    args.fail("--threshold " + std::to_string(o.model.threshold) + " must be below --levels " +
+              std::to_string(o.model.levels));
   }
   const bool from_readings = !o.readings.empty(), from_session = !o.session.empty();
   if (from_readings && from_session) args.fail("--readings and --session exclude each other");
@@ -365,12 +402,14 @@ int main(int argc, char** argv) {
     args.fail("only one input can be standard input (-)");
   }
   args.check_output(o.files[1], {o.files[0], o.readings, o.poses, o.session});
-  std::vector<taxel::Contact<double>> contacts;
   taxel::sensor::ContactOptions copt;
   copt.mode =
       o.per_pad ? taxel::sensor::ContactMode::per_pad : taxel::sensor::ContactMode::per_tactel;
   std::string shortfall;  // a session replay that ended early: the output is kept, exit 1
-  try {
+  // Readings and sessions become contacts in memory (a stack of readings is itself held
+  // whole); a CSV is read a batch at a time.
+  const auto whole = [&](std::vector<taxel::Contact<double>>& batch) {
+    batch.clear();
     if (from_readings) {
       auto stack = taxel::sensor::ReadingStack::from_npy(taxel::io::parse_npy_u16(
           taxel_cli::read_input(o.readings), taxel_cli::input_name(o.readings)));
@@ -380,24 +419,47 @@ int main(int argc, char** argv) {
       model.geometry.rows = static_cast<int>(stack.rows);
       model.geometry.cols = static_cast<int>(stack.cols);
       const auto r =
-          taxel::sensor::contacts_from_readings(stack, poses, model, copt, o.frame_rate, contacts);
+          taxel::sensor::contacts_from_readings(stack, poses, model, copt, o.frame_rate, batch);
       summary["readings"] = {{"frames", stack.frames},     {"pads", stack.pads},
                              {"rows", stack.rows},         {"cols", stack.cols},
                              {"pad_frames", r.pad_frames}, {"touching", r.touching}};
-    } else if (from_session) {
-      shortfall = session_contacts(o, copt, contacts);
+    } else {
+      shortfall = session_contacts(o, copt, batch);
       if (!shortfall.empty()) {
         std::fprintf(stderr, "taxel-fuse: %s: %s; fusing the frames before it (exit 1)\n",
                      o.session.c_str(), shortfall.c_str());
       }
-    } else {
-      taxel::io::ContactsCsvReport report;
-      const std::string name = taxel_cli::input_name(o.files[0]);
-      contacts = taxel::io::parse_contacts_csv(taxel_cli::read_input(o.files[0]), name,
-                                               {.strict = o.strict}, &report);
-      for (const auto& c : report.ignored_columns) {
+    }
+    return false;
+  };
+  const std::string name = taxel_cli::input_name(o.files[0]);
+  std::optional<taxel::io::ContactsCsvReader> csv;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  const auto stream = [&](std::vector<taxel::Contact<double>>& batch) {
+    batch.clear();
+    if (!csv) {
+      csv.emplace(o.files[0] == "-" ? std::string("/dev/stdin") : o.files[0],
+                  taxel::io::ContactsCsvOptions{.strict = o.strict}, name);
+    }
+    const bool more = csv->read(batch, std::size_t{1} << 16);
+    for (auto& c : batch) {
+      c.position *= o.scale;
+      c.covariance *= o.scale * o.scale;
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], c.position[k]);
+        hi[k] = std::max(hi[k], c.position[k]);
+      }
+    }
+    if (!more) {  // the whole file is read: what was left out, and the units
+      const auto& report = csv->report();
+      const std::size_t shown = std::min<std::size_t>(report.ignored_columns.size(), 5);
+      for (std::size_t k = 0; k < shown; ++k) {
         std::fprintf(stderr, "taxel-fuse: %s: ignoring unknown column '%s'\n", name.c_str(),
-                     c.c_str());
+                     taxel_cli::printable(report.ignored_columns[k]).c_str());
+      }
+      if (report.ignored_columns.size() > shown) {
+        std::fprintf(stderr, "taxel-fuse: %s: ignoring %zu more unknown columns\n", name.c_str(),
+                     report.ignored_columns.size() - shown);
       }
       skipped_rows = report.skipped_rows;
       if (report.skipped_rows > 0) {
@@ -405,20 +467,13 @@ int main(int argc, char** argv) {
                      "taxel-fuse: skipped %zu bad rows (--strict refuses them); the first: %s\n",
                      report.skipped_rows, report.first_skipped.c_str());
       }
-      if (o.scale != 1.0) {
-        for (auto& c : contacts) {
-          c.position *= o.scale;
-          c.covariance *= o.scale * o.scale;
-        }
-      }
-      std::vector<Eigen::Vector3d> at;
-      at.reserve(contacts.size());
-      for (const auto& c : contacts) at.push_back(c.position);
-      taxel_cli::warn_if_millimetres("taxel-fuse", name, taxel_cli::largest_extent(at));
+      double extent = 0.0;
+      for (int k = 0; k < 3; ++k) extent = std::max(extent, hi[k] - lo[k]);
+      taxel_cli::warn_if_millimetres("taxel-fuse", name, extent);
     }
-  } catch (const std::exception& e) {
-    args.fail(e.what(), 1);
-  }
+    return more;
+  };
+  const Feed feed = from_readings || from_session ? Feed(whole) : Feed(stream);
   namespace tf = taxel::fusion;
   try {
     int code = 0;
@@ -426,13 +481,13 @@ int main(int argc, char** argv) {
     kc.process_noise = o.process_noise;
     if (o.gate != 0.0) kc.gate_chi2 = o.gate;
     if (o.policy == "raw") {
-      code = with_index<tf::Raw<double>>(o, {}, contacts, args);
+      code = with_index<tf::Raw<double>>(o, {}, feed, args);
     } else if (o.policy == "average") {
-      code = with_index<tf::Average<double>>(o, {}, contacts, args);
+      code = with_index<tf::Average<double>>(o, {}, feed, args);
     } else if (o.policy == "kalman") {
-      code = with_index<tf::Kalman<double>>(o, kc, contacts, args);
+      code = with_index<tf::Kalman<double>>(o, kc, feed, args);
     } else {
-      code = with_index<tf::Surfel<double>>(o, {.kalman = kc}, contacts, args);
+      code = with_index<tf::Surfel<double>>(o, {.kalman = kc}, feed, args);
     }
     return code == 0 && !shortfall.empty() ? 1 : code;
   } catch (const std::invalid_argument& e) {  // a configuration the cloud refuses

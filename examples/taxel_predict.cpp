@@ -94,6 +94,8 @@ int main(int argc, char** argv) {
             2);
       } else if (a.size() > 1 && a[0] == '-') {
         fail("unknown option '" + std::string(a) + "' (see --help)", 2);
+      } else if (a.empty()) {
+        fail("an argument is empty: name a file", 2);
       } else {
         files.emplace_back(a);
       }

@@ -174,11 +174,13 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
     if (!contacts.empty() && f.time > contacts.back().time) break;
     ++frames;
   }
+  // Written as a set: a readings file never lands beside the poses of an earlier run.
+  std::vector<std::pair<std::string, std::string>> outputs;
   try {
-    taxel_cli::write_output(o.files[0], taxel::io::encode_contacts_csv(contacts));
+    outputs.emplace_back(o.files[0], taxel::io::encode_contacts_csv(contacts));
     if (o.files.size() > 1) {
-      taxel_cli::write_output(o.files[1], taxel::io::encode_ply(ts::sample_surface(
-                                              ex.truth, o.truth_points, o.config.seed)));
+      outputs.emplace_back(o.files[1], taxel::io::encode_ply(ts::sample_surface(
+                                           ex.truth, o.truth_points, o.config.seed)));
     }
     if (!o.readings.empty() || !o.poses.empty()) {
       const auto& g = o.config.sensor.geometry;
@@ -194,12 +196,13 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
       }
       const std::size_t dims[4] = {frames, pads, std::size_t(g.rows), std::size_t(g.cols)};
       if (!o.readings.empty()) {
-        taxel_cli::write_output(o.readings, taxel::io::encode_npy_u16(dims, values));
+        outputs.emplace_back(o.readings, taxel::io::encode_npy_u16(dims, values));
       }
       if (!o.poses.empty()) {
-        taxel_cli::write_output(o.poses, taxel::io::encode_pad_poses_csv(poses));
+        outputs.emplace_back(o.poses, taxel::io::encode_pad_poses_csv(poses));
       }
     }
+    taxel_cli::write_outputs(outputs);
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }

@@ -174,6 +174,8 @@ int main(int argc, char** argv) {
         cfg.class_weights.emplace_back(label, number(a, value()));
       } else if (a.size() > 1 && a[0] == '-') {
         usage_error("unknown option '" + std::string(a) + "' (see --help)");
+      } else if (a.empty()) {
+        usage_error("an argument is empty: name a file");
       } else if (data_file.empty()) {
         data_file = a;
       } else if (model_file.empty()) {

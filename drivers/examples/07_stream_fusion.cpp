@@ -55,10 +55,10 @@ struct Options {
 // `file_error`: the malformed line that cut a replayed session short ("" for a whole file or a
 // live device).
 template <class T>
-int run(T transport, const Options& o, const std::map<std::uint32_t, cli::Poses>& pose_table,
-        const taxel_cli::Args& args, const std::string& file_error = {}) {
-  td::DsaconDevice dev(std::move(transport),
-                       {.frame_timeout = td::Timeout(o.replay.empty() ? 1000 : 50)});
+int run(T transport, const Options& o, const std::string& poses_text, const taxel_cli::Args& args,
+        const std::string& file_error = {}) {
+  const td::Timeout timeout(o.replay.empty() ? 1000 : 50);  // a replay answers at once or never
+  td::DsaconDevice dev(std::move(transport), {.reply_timeout = timeout, .frame_timeout = timeout});
   taxel::fusion::ContactCloud<taxel::fusion::Kalman<double>, taxel::index::VoxelHash<double>> cloud(
       {.association_radius = 4e-3});
   std::vector<taxel::Contact<double>> contacts;
@@ -70,19 +70,20 @@ int run(T transport, const Options& o, const std::map<std::uint32_t, cli::Poses>
   try {
     dev.open();
     const cli::Poses fixed = cli::static_poses(dev.matrices());
+    td::SessionPoses table;
+    if (!o.poses.empty()) table = td::SessionPoses(poses_text, o.poses, dev.matrices().size());
+    cli::Poses poses;
     dev.start();
     while (limit < 0 || long(frames) < limit) {
       const auto f = dev.read_frame();
       if (!f) {  // the end of the session, or a silent device
         if constexpr (std::is_same_v<T, td::ReplayTransport>) {
-          shortfall = td::replay_shortfall(dev.transport(), dev.unparsed_bytes(), file_error);
+          shortfall = td::finish_replay(dev, file_error);
         }
         break;
       }
       ++frames;
-      const auto it = pose_table.find(f->device_time_ms);
-      const cli::Poses& poses = it != pose_table.end() ? it->second : fixed;
-      posed += it != pose_table.end() ? 1 : 0;
+      posed += table.frame_poses(*f, fixed, td::PadCalibration{}.threshold, o.poses, poses);
       contacts.clear();
       td::frame_contacts(
           *f, dev.matrices(), poses, contacts,
@@ -159,20 +160,19 @@ int main(int argc, char** argv) {
     if (o.poses.empty()) o.poses = TAXEL_SESSION_DIR "/cylinder_grasp_poses.csv";
   }
   try {
-    std::map<std::uint32_t, cli::Poses> pose_table;
-    if (!o.poses.empty()) pose_table = cli::read_poses_csv(o.poses);
+    const std::string poses_text = o.poses.empty() ? std::string() : taxel::io::read_file(o.poses);
     if (!o.replay.empty()) {
       td::SessionPrefix file = td::read_session_prefix(o.replay);
       if (file.chunks.empty() && !file.error.empty()) throw td::SessionError(file.error);
-      return run(td::ReplayTransport(std::move(file.chunks), o.realtime), o, pose_table, args,
+      return run(td::ReplayTransport(std::move(file.chunks), o.realtime), o, poses_text, args,
                  file.error);
     }
-    if (!o.serial.empty()) return run(td::SerialTransport(o.serial), o, pose_table, args);
+    if (!o.serial.empty()) return run(td::SerialTransport(o.serial), o, poses_text, args);
     const auto ids = cli::parse_pair(o.usb, 16);
     if (!ids) args.fail("--usb: '" + o.usb + "' is not of the form VID:PID (hex)");
     return run(td::UsbTransport({.vendor_id = std::uint16_t(ids->first),
                                  .product_id = std::uint16_t(ids->second)}),
-               o, pose_table, args);
+               o, poses_text, args);
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }

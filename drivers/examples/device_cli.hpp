@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Shared by the driver tools: pad poses per frame (CSV), static poses from the controller's
+// Shared by the driver tools: pad poses per frame as CSV text, static poses from the controller's
 // matrix info, and the simulated hand that drives the emulated controller.
 #pragma once
 
@@ -43,57 +43,9 @@ inline std::optional<std::pair<unsigned, unsigned>> parse_pair(const std::string
   return std::pair<unsigned, unsigned>(x, y);
 }
 
-/// Pad poses of each frame, keyed by the controller's time stamp [ms]. CSV with header
-/// `time_ms,matrix,x,y,z,qw,qx,qy,qz` (metres; unit quaternion pad -> world).
-/// Within a frame the rows run over the matrices in order, 0, 1, 2, ...
-inline std::map<std::uint32_t, Poses> read_poses_csv(const std::string& path) {
-  std::istringstream in(taxel::io::read_file(path));
-  std::string line;
-  std::size_t line_no = 1;
-  if (!std::getline(in, line) || line != "time_ms,matrix,x,y,z,qw,qx,qy,qz") {
-    throw std::runtime_error(path + ":1: expected the header time_ms,matrix,x,y,z,qw,qx,qy,qz");
-  }
-  std::map<std::uint32_t, Poses> out;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty()) continue;
-    std::istringstream ss(line);
-    std::string cell;
-    std::vector<double> v;
-    while (std::getline(ss, cell, ',')) {
-      char* end = nullptr;
-      const double x = std::strtod(cell.c_str(), &end);
-      if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(x)) {
-        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": '" + cell +
-                                 "' is not a finite number");
-      }
-      v.push_back(x);
-    }
-    if (v.size() != 9) {
-      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": " +
-                               std::to_string(v.size()) + " values, expected 9");
-    }
-    const Eigen::Quaterniond q(v[5], v[6], v[7], v[8]);
-    if (v[0] < 0 || v[0] > 4294967295.0 || std::abs(q.norm() - 1.0) > 1e-6) {
-      throw std::runtime_error(path + ":" + std::to_string(line_no) +
-                               ": time_ms must be a u32 and the quaternion of unit length");
-    }
-    Poses& p = out[static_cast<std::uint32_t>(v[0])];
-    if (v[1] != double(p.size())) {
-      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": matrix " +
-                               std::to_string(v[1]) + ", expected " + std::to_string(p.size()) +
-                               " (a frame's rows run over the matrices in order)");
-    }
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = q.toRotationMatrix();
-    T.translation() = taxel::Vec3d(v[2], v[3], v[4]);
-    p.push_back(T);
-  }
-  return out;
-}
-
-/// Writes poses in the format read_poses_csv reads, whole or not at all (taxel::io::write_file).
-inline void write_poses_csv(const std::string& path, const std::map<std::uint32_t, Poses>& poses) {
+/// The text of poses in the drivers' form (time_ms,matrix,x,y,z,qw,qx,qy,qz), which
+/// taxel::drivers::SessionPoses reads.
+inline std::string poses_csv(const std::map<std::uint32_t, Poses>& poses) {
   std::ostringstream out;
   out << "time_ms,matrix,x,y,z,qw,qx,qy,qz\n";
   out.precision(9);
@@ -105,7 +57,7 @@ inline void write_poses_csv(const std::string& path, const std::map<std::uint32_
           << q.x() << ',' << q.y() << ',' << q.z() << '\n';
     }
   }
-  taxel::io::write_file(path, out.str());
+  return out.str();
 }
 
 /// Fixed pad poses from the matrix info (centre in mm, angles in rad, rotation

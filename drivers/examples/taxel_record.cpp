@@ -66,7 +66,8 @@ struct Options {
 taxel_cli::Json summary = taxel_cli::Json::object();
 
 template <class T>
-int record(T transport, const Options& o, const taxel_cli::Args& args) {
+int record(T transport, const Options& o, const taxel_cli::Args& args,
+           const std::string& poses_text = {}) {
   td::DsaconDevice dev(
       td::RecordingTransport<T>(std::move(transport)),
       {.reply_timeout = td::Timeout(o.timeout_ms), .frame_timeout = td::Timeout(o.timeout_ms)});
@@ -83,7 +84,11 @@ int record(T transport, const Options& o, const taxel_cli::Args& args) {
     }
     dev.stop();
     dev.close();
-    taxel_cli::write_output(o.out, td::format_session(dev.transport().chunks()));
+    // The session and its poses as a set: neither replaces an earlier run's file alone.
+    std::vector<std::pair<std::string, std::string>> outputs{
+        {o.out, td::format_session(dev.transport().chunks())}};
+    if (!o.poses.empty()) outputs.emplace_back(o.poses, poses_text);
+    taxel_cli::write_outputs(outputs);
   } catch (const std::exception& e) {
     args.fail(e.what(), 1);
   }
@@ -123,7 +128,7 @@ int emulate(const Shape& shape, const Options& o, const taxel_cli::Args& args) {
   std::thread controller([&] { emulator.serve(device, stop, true); });
   int rc = 1;
   try {
-    rc = record(std::move(host), with_frames, args);
+    rc = record(std::move(host), with_frames, args, cli::poses_csv(hand.poses));
   } catch (...) {
     stop = true;
     controller.join();
@@ -131,14 +136,7 @@ int emulate(const Shape& shape, const Options& o, const taxel_cli::Args& args) {
   }
   stop = true;
   controller.join();
-  if (!o.poses.empty()) {
-    try {
-      cli::write_poses_csv(o.poses, hand.poses);
-    } catch (const std::exception& e) {
-      args.fail(e.what(), 1);
-    }
-    summary["poses"] = o.poses;
-  }
+  if (!o.poses.empty()) summary["poses"] = o.poses;
   return rc;
 }
 

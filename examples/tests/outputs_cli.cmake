@@ -152,3 +152,40 @@ set(same "are the same file")
 expect_refused("${SIMULATE}" "${same}" --contacts 500 c6.csv c6.csv)
 expect_refused("${SIMULATE}" "${same}" --contacts 500 --readings r6.npy --poses r6.npy c6.csv)
 expect_refused("${SIMULATE}" "${same}" --contacts 500 --poses c6.csv c6.csv)
+
+# Outputs that belong together are written as a set: when one of them cannot be written (its
+# folder is missing; a disk that fills up part-way fails the same way, at the writes), none
+# replaces its previous version, so new readings never sit beside old poses.
+file(WRITE "${WORK_DIR}/set_readings.npy" "previous\n")
+file(WRITE "${WORK_DIR}/set_contacts.csv" "previous\n")
+run_tool("${SIMULATE}" 1 --contacts 500 --seed 4 --readings set_readings.npy
+         --poses no_such_folder/p.csv set_contacts.csv)
+expect("${err}" "no_such_folder/p.csv")
+foreach(f set_readings.npy set_contacts.csv)
+  file(READ "${WORK_DIR}/${f}" kept)
+  if(NOT kept STREQUAL "previous\n")
+    message(FATAL_ERROR "taxel-simulate replaced ${f} although the set failed")
+  endif()
+endforeach()
+file(GLOB left "${WORK_DIR}/.set_*.tmp.*")
+if(left)
+  message(FATAL_ERROR "taxel-simulate left temporary files behind: ${left}")
+endif()
+# Other tools' outputs named by the file they open: standard input as /dev/stdin.
+foreach(alias /dev/stdin /dev/fd/0)
+  execute_process(COMMAND "${ICP}" - truth.ply -o ${alias} WORKING_DIRECTORY "${WORK_DIR}"
+                  INPUT_FILE "${WORK_DIR}/cloud.ply" RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "is the input '<stdin>'")
+    message(FATAL_ERROR "taxel-icp -o ${alias} with the source on standard input: exit ${rc}\n${err}")
+  endif()
+  execute_process(COMMAND "${DESCRIBE}" - -o ${alias} WORKING_DIRECTORY "${WORK_DIR}"
+                  INPUT_FILE "${WORK_DIR}/image.csv" RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "is the input '<stdin>'")
+    message(FATAL_ERROR "taxel-describe -o ${alias}: exit ${rc}\n${err}")
+  endif()
+  execute_process(COMMAND "${PREDICT}" - data.model ${alias} WORKING_DIRECTORY "${WORK_DIR}"
+                  INPUT_FILE "${WORK_DIR}/data.libsvm" RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "is the input '<stdin>'")
+    message(FATAL_ERROR "taxel-predict - data.model ${alias}: exit ${rc}\n${err}")
+  endif()
+endforeach()

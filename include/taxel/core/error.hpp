@@ -11,7 +11,8 @@
 namespace taxel {
 
 /// A file or stream could not be read or written, or its content is malformed.
-/// `what()` reads "<source>:<line>: <reason>" or "<source>: byte <offset>: <reason>".
+/// `what()` reads "<source>:<line>: <reason>" or "<source>: byte <offset>: <reason>", with
+/// control characters shown as \xNN so that it stays one whole line.
 class IoError : public std::runtime_error {
  public:
   /// `source` names the file (or stream); `line` is 1-based; `byte_offset` is 0-based.
@@ -43,7 +44,21 @@ class IoError : public std::runtime_error {
     if (line) s.append(":").append(std::to_string(*line));
     if (byte_offset) s.append(": byte ").append(std::to_string(*byte_offset));
     s.append(": ").append(reason);
-    return s;
+    // Control bytes quoted from an input (a NUL, a line break, an escape) are shown as \xNN:
+    // a NUL would cut the message where C strings end, a line break would split it.
+    std::string out;
+    out.reserve(s.size());
+    for (const char c : s) {
+      const auto u = static_cast<unsigned char>(c);
+      if (u >= 0x20 && u != 0x7f) {
+        out.push_back(c);
+      } else {
+        static constexpr char kHex[] = "0123456789abcdef";
+        out.append("\\x").push_back(kHex[u >> 4]);
+        out.push_back(kHex[u & 15]);
+      }
+    }
+    return out;
   }
 
   std::string source_;

@@ -6,16 +6,23 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstddef>
+#include <map>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "taxel/core/contact.hpp"
+#include "taxel/core/error.hpp"
 #include "taxel/drivers/dsacon_device.hpp"
 #include "taxel/image/types.hpp"
+#include "taxel/io/pad_poses_csv.hpp"
 #include "taxel/sensor/contacts.hpp"
 #include "taxel/sim/sensor.hpp"
 
@@ -98,6 +105,81 @@ inline std::size_t frame_contacts(const TactileFrame& frame,
   }
   return n;
 }
+
+/// Pad poses of a recorded session, by the controller's time stamp: the world pose of each
+/// matrix at each frame time, read from a pad poses CSV in the drivers' form (columns time_ms and
+/// matrix, as taxel-record --poses writes it; io/pad_poses_csv.hpp).
+class SessionPoses {
+ public:
+  SessionPoses() = default;
+
+  /// Reads `text` for a session of `matrices` matrices. Throws taxel::IoError naming `source`:
+  /// for the frame,pad form (its frames count a stack of readings, not the controller's clock),
+  /// a matrix index beyond the session's, and what io::parse_pad_poses_csv refuses.
+  SessionPoses(std::string_view text, const std::string& source, std::size_t matrices) {
+    io::LineReader lines(text);
+    std::string_view header;
+    while (lines.next(header) && io::blank_or_comment(header)) {
+    }
+    bool time_ms = false, frame = false;
+    for (std::size_t at = 0; at <= header.size();) {
+      const std::size_t comma = std::min(header.find(',', at), header.size());
+      std::string_view cell = header.substr(at, comma - at);
+      while (!cell.empty() && cell.front() == ' ') cell.remove_prefix(1);
+      while (!cell.empty() && cell.back() == ' ') cell.remove_suffix(1);
+      time_ms = time_ms || cell == "time_ms";
+      frame = frame || cell == "frame";
+      at = comma + 1;
+    }
+    if (frame || !time_ms) {
+      throw IoError(source,
+                    "a session's poses are keyed by the controller's clock: the header needs "
+                    "time_ms and matrix (as taxel-record --poses writes them), not frame and pad",
+                    lines.line_number());
+    }
+    for (const io::PadPose& p : io::parse_pad_poses_csv(text, source)) {
+      if (p.pad >= matrices) {
+        throw IoError(source, "matrix " + std::to_string(p.pad) + " at time_ms " +
+                                  std::to_string(std::llround(p.time * 1e3)) + ": the session has " +
+                                  std::to_string(matrices) + " matrices (0 to " +
+                                  std::to_string(matrices - 1) + ")");
+      }
+      auto& row = table_[static_cast<std::uint32_t>(std::llround(p.time * 1e3))];
+      row.resize(matrices);
+      row[p.pad] = p.pose;
+    }
+  }
+
+  /// True when no pose was read.
+  [[nodiscard]] bool empty() const noexcept { return table_.empty(); }
+
+  /// The poses of `frame`'s matrices into `out`: the table's at the frame's time stamp, or all
+  /// of `fallback` when the table is empty. A matrix without a pose that reads no contact
+  /// (every reading below `threshold`) gets `fallback`'s pose, which places nothing. Returns
+  /// true when the table has a row at the frame's time. Throws taxel::IoError naming `source`
+  /// when a matrix that reads contact has no pose, as readings without a pose are refused.
+  bool frame_poses(const TactileFrame& frame, std::span<const Eigen::Isometry3d> fallback,
+                   int threshold, const std::string& source,
+                   std::vector<Eigen::Isometry3d>& out) const {
+    out.assign(fallback.begin(), fallback.end());
+    if (table_.empty()) return false;
+    const auto it = table_.find(frame.device_time_ms);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (it != table_.end() && i < it->second.size() && it->second[i]) {
+        out[i] = *it->second[i];
+      } else if (i < frame.matrices.size() &&
+                 (frame.matrices[i].template cast<int>() >= threshold).any()) {
+        throw IoError(source, "no pose for matrix " + std::to_string(i) + " at time_ms " +
+                                  std::to_string(frame.device_time_ms) +
+                                  ", where the session's frame reads contact on it");
+      }
+    }
+    return it != table_.end();
+  }
+
+ private:
+  std::map<std::uint32_t, std::vector<std::optional<Eigen::Isometry3d>>> table_;
+};
 
 /// Matrix `i` of a frame as a pressure image (rows x cols, the raw readings as doubles).
 inline image::ImageD frame_image(const TactileFrame& frame, std::size_t i) {

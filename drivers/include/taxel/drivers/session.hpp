@@ -273,6 +273,10 @@ class ReplayTransport {
     return why;
   }
 
+  /// The session file's line of the device bytes read last (0 before any, or for chunks not
+  /// read from a file): where to look when the device's reply does not parse.
+  std::uint64_t last_read_line() const noexcept { return last_line_; }
+
   /// Checks `bytes` against the recorded host stream.
   void write(std::span<const std::uint8_t> bytes, Timeout) {
     if (!open_) throw TransportError(TransportErrorKind::not_open, "replay: not open");
@@ -313,6 +317,7 @@ class ReplayTransport {
     }
     const std::size_t n = std::min(into.size(), c.bytes.size() - dev_off_);
     std::copy_n(c.bytes.begin() + long(dev_off_), n, into.begin());
+    last_line_ = c.line;
     dev_off_ += n;
     if (dev_off_ == c.bytes.size()) {
       dev_off_ = 0;
@@ -334,6 +339,7 @@ class ReplayTransport {
   bool open_ = false;
   std::size_t host_ = 0, host_off_ = 0;  // next host chunk to be written, and the byte in it
   std::size_t dev_ = 0, dev_off_ = 0;    // next device chunk to be read, and the byte in it
+  std::uint64_t last_line_ = 0;          // file line of the device bytes read last
   std::chrono::steady_clock::time_point start_;
 };
 
@@ -356,6 +362,25 @@ inline std::string replay_shortfall(const ReplayTransport& replay, std::size_t u
         " bytes of it were recorded)");
   }
   if (!file_error.empty()) add(file_error + " (the chunks before it were replayed)");
+  return why;
+}
+
+/// Ends the replay of a recorded session once `device` (a DsaconDevice over a ReplayTransport)
+/// delivers no more frames: returns why the replay fell short of the whole recording, or ""
+/// when it played all of it (replay_shortfall's reasons, and a recording that ends before the
+/// host's stop command: taxel-record stops the controller before it saves, so a recording cut
+/// short, even at a line boundary, lacks it). Then closes the device.
+template <class Device>
+std::string finish_replay(Device& device, const std::string& file_error = {}) {
+  std::string why = replay_shortfall(device.transport(), device.unparsed_bytes(), file_error);
+  if (why.empty() && device.streaming()) {
+    try {
+      device.stop();
+    } catch (const std::exception&) {
+      why = "the recording ends before the host's stop command: it was cut short";
+    }
+  }
+  device.close();
   return why;
 }
 
