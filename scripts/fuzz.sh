@@ -19,6 +19,10 @@ cmake --build build/fuzz -j2 --target "${targets[@]}"
 for t in "${targets[@]}"; do
   corpus="build/fuzz/corpus/$t"
   mkdir -p "$corpus"
+  if [ "$t" = fuzz_session ] && [ ! -e "$corpus/seed" ]; then  # the committed session and its poses
+    { cat data/sessions/cylinder_grasp.session; printf '#poses\n'
+      cat data/sessions/cylinder_grasp_poses.csv; } > "$corpus/seed"
+  fi
   echo "== $t: ${seconds}s"
   "build/fuzz/tests/fuzz/$t" -max_total_time="$seconds" -print_final_stats=1 \
     -artifact_prefix="build/fuzz/" "$corpus"

@@ -11,13 +11,17 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <cstdint>
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <mutex>
+#include <shared_mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -30,12 +34,93 @@ namespace taxel::python {
 
 namespace py = pybind11;
 
-/// A C-contiguous float64 array; other dtypes and layouts are converted (copied) on the way in,
-/// a C-contiguous float64 array is taken as it is.
-using ArrayD = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using ArrayI = py::array_t<int, py::array::c_style | py::array::forcecast>;
-using ArrayU16 = py::array_t<std::uint16_t, py::array::c_style | py::array::forcecast>;
-using ArrayU8 = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
+/// A C-contiguous numpy array of T taken strictly, by the one conversion every argument of the
+/// module goes through: a C-contiguous array of T is taken as it is (no copy); another array,
+/// or a list, is converted when its values are real numbers (bool, integer or floating dtypes;
+/// strings, complex numbers, dates and objects raise TypeError) and, for an integer T, when
+/// every value is a whole number in T's range (100.7, NaN, -1 for uint16, 65536 + v, 2^33 for
+/// int32 raise ValueError naming the value and its index), never truncated or wrapped.
+template <class T>
+class StrictArray : public py::array_t<T, py::array::c_style | py::array::forcecast> {
+ public:
+  using Base = py::array_t<T, py::array::c_style | py::array::forcecast>;
+  using Base::Base;
+  StrictArray() = default;
+  StrictArray(Base&& a) : Base(std::move(a)) {}  // NOLINT: implicit, as array_t's own
+};
+using ArrayD = StrictArray<double>;
+using ArrayI = StrictArray<int>;
+using ArrayI64 = StrictArray<std::int64_t>;
+using ArrayU16 = StrictArray<std::uint16_t>;
+using ArrayU8 = StrictArray<std::uint8_t>;
+
+namespace detail {
+
+/// The numpy name of a dtype ("<U3", "complex128").
+inline std::string dtype_name(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+
+/// "(i, j)" of the flat C-order index `k` of `a`.
+inline std::string index_text(const py::array& a, py::ssize_t k) {
+  std::string out;
+  for (py::ssize_t d = a.ndim(); d-- > 0;) {
+    const py::ssize_t n = a.shape(d) > 0 ? a.shape(d) : 1;
+    out = std::to_string(k % n) + (out.empty() ? "" : ", ") + out;
+    k /= n;
+  }
+  return "[" + out + "]";
+}
+
+/// Converts `src` for StrictArray<T> (see there); throws TypeError or ValueError.
+template <class T>
+StrictArray<T> strict_array(py::handle src) {
+  using Base = typename StrictArray<T>::Base;
+  py::array a = py::array::ensure(src);
+  if (!a) throw py::type_error("expected an array of numbers");
+  const char kind = a.dtype().kind();
+  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f') {
+    throw py::type_error("expected an array of real numbers, got an array of dtype " +
+                         dtype_name(a));
+  }
+  if constexpr (std::is_integral_v<T>) {
+    if (!a.dtype().is(py::dtype::of<T>()) && kind != 'b') {
+      constexpr auto lo = static_cast<long double>(std::numeric_limits<T>::min());
+      constexpr auto hi = static_cast<long double>(std::numeric_limits<T>::max());
+      const std::string range = std::to_string(std::numeric_limits<T>::min()) + ", " +
+                                std::to_string(std::numeric_limits<T>::max());
+      const auto refuse = [&](py::ssize_t k, const std::string& value) {
+        throw py::value_error("expected whole numbers in [" + range + "], got " + value +
+                              " at " + index_text(a, k));
+      };
+      if (kind == 'f') {
+        const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+        for (py::ssize_t k = 0; k < d.size(); ++k) {
+          const double v = d.data()[k];
+          if (!(std::isfinite(v) && v == std::floor(v) && v >= lo && v <= hi)) {
+            refuse(k, py::repr(py::float_(v)).cast<std::string>());
+          }
+        }
+      } else if (kind == 'u') {
+        const auto u =
+            py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+        for (py::ssize_t k = 0; k < u.size(); ++k) {
+          if (static_cast<long double>(u.data()[k]) > hi) refuse(k, std::to_string(u.data()[k]));
+        }
+      } else {
+        const auto i =
+            py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+        for (py::ssize_t k = 0; k < i.size(); ++k) {
+          const auto v = static_cast<long double>(i.data()[k]);
+          if (v < lo || v > hi) refuse(k, std::to_string(i.data()[k]));
+        }
+      }
+    }
+  }
+  Base out = Base::ensure(a);
+  if (!out) throw py::error_already_set();
+  return StrictArray<T>(std::move(out));
+}
+
+}  // namespace detail
 
 inline std::string shape_text(const py::array& a) {
   std::string s = "(";
@@ -61,6 +146,25 @@ inline void require_shape(const py::array& a, std::initializer_list<py::ssize_t>
     throw py::value_error(std::string(what) + ": expected an array of shape " + expected +
                           ", got " + shape_text(a));
   }
+}
+
+/// The reader-writer lock of the bound C++ object at `object`. Methods that release the GIL
+/// take it after releasing the GIL (exclusively when they change the object, shared when they
+/// read it), and so do the methods that touch the object with the GIL held; a thread holding
+/// it never waits for the GIL. So two Python threads may share one object: their calls on it
+/// run one at a time (reads together). The locks are striped over the objects' addresses: two
+/// objects may share one, which only serialises them.
+inline std::shared_mutex& object_mutex(const void* object) {
+  static std::shared_mutex stripes[64];
+  return stripes[(reinterpret_cast<std::uintptr_t>(object) >> 4) % 64];
+}
+/// An exclusive lock on `object` (see object_mutex).
+inline std::unique_lock<std::shared_mutex> write_lock(const void* object) {
+  return std::unique_lock<std::shared_mutex>(object_mutex(object));
+}
+/// A shared lock on `object` (see object_mutex).
+inline std::shared_lock<std::shared_mutex> read_lock(const void* object) {
+  return std::shared_lock<std::shared_mutex>(object_mutex(object));
 }
 
 /// Writes a 3-vector to out[0..3).
@@ -176,6 +280,32 @@ void bind_io(py::module_& m);
 void bind_sim(py::module_& m);
 
 }  // namespace taxel::python
+
+namespace pybind11::detail {
+/// Arguments of type StrictArray<T> go through taxel::python::detail::strict_array.
+// The enable_if form of pybind11's own caster for Python object types, more specialised.
+template <class T>
+struct type_caster<taxel::python::StrictArray<T>,
+                   enable_if_t<is_pyobject<taxel::python::StrictArray<T>>::value>> {
+  using Array = taxel::python::StrictArray<T>;
+  PYBIND11_TYPE_CASTER(Array, handle_type_name<typename Array::Base>::name);
+  bool load(handle src, bool convert) {
+    if (!convert) {  // the no-conversion pass: exactly an array of T, C-contiguous
+      if (!Array::Base::check_(src)) return false;
+      value = reinterpret_borrow<typename Array::Base>(src);
+      return true;
+    }
+    // Neither an array nor a sequence: another overload may take it.
+    if (!isinstance<array>(src) && !isinstance<sequence>(src)) return false;
+    if (isinstance<str>(src) || isinstance<bytes>(src)) return false;
+    value = taxel::python::detail::strict_array<T>(src);
+    return true;
+  }
+  static handle cast(const Array& src, return_value_policy, handle) {
+    return src.inc_ref();
+  }
+};
+}  // namespace pybind11::detail
 
 PYBIND11_MAKE_OPAQUE(taxel::python::ContactList)
 

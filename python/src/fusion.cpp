@@ -42,6 +42,7 @@ class CloudBase {
   virtual BatchResult insert(const ContactRows& rows) = 0;
   virtual BatchResult insert(const ContactList& cs) = 0;
   virtual InsertResult insert(const Contact<double>& c) = 0;
+  virtual ContactDefect defect(const Contact<double>& c) const = 0;
   virtual std::size_t size() const = 0;
   virtual void clear() = 0;
   virtual void reserve(std::size_t n) = 0;
@@ -69,6 +70,7 @@ class CloudImpl final : public CloudBase {
   }
   BatchResult insert(const ContactList& cs) override { return cloud_.insert(cs); }
   InsertResult insert(const Contact<double>& c) override { return cloud_.insert(c); }
+  ContactDefect defect(const Contact<double>& c) const override { return cloud_.defect(c); }
   std::size_t size() const override { return cloud_.size(); }
   void clear() override { cloud_.clear(); }
   void reserve(std::size_t n) override { cloud_.reserve(n); }
@@ -201,10 +203,11 @@ py::dict batch_dict(const BatchResult& r) {
   return d;
 }
 
-/// The first invalid contact of `rows`, as a ValueError naming the row and the defect.
-void check_rows(const ContactRows& rows) {
+/// The first contact of `rows` that `cloud` would reject (an invalid one, or one beyond its
+/// index's range), as a ValueError naming the row and the defect.
+void check_rows(const CloudBase& cloud, const ContactRows& rows) {
   for (std::size_t i = 0; i < rows.n; ++i) {
-    const ContactDefect d = check_contact(rows.at(i));
+    const ContactDefect d = cloud.defect(rows.at(i));
     if (d != ContactDefect::ok) {
       throw py::value_error("contact " + std::to_string(i) + ": " + std::string(to_string(d)) +
                             " (nothing was inserted; strict=False skips invalid contacts)");
@@ -415,7 +418,11 @@ Options that the chosen policy or index does not use must stay at their defaults
       .def_readonly("policy", &PyContactCloud::policy)
       .def_readonly("index", &PyContactCloud::index)
       .def_readonly("association_radius", &PyContactCloud::association_radius)
-      .def("__len__", [](const PyContactCloud& c) { return c.impl->size(); })
+      .def("__len__",
+           [](const PyContactCloud& c) {
+             const auto lock = read_lock(&c);
+             return c.impl->size();
+           })
       .def(
           "insert",
           [](PyContactCloud& c, ArrayD positions, std::optional<ArrayD> covariances,
@@ -424,10 +431,13 @@ Options that the chosen policy or index does not use must stay at their defaults
             const ContactRows rows =
                 contact_rows(std::move(positions), std::move(covariances), std::move(normals),
                              std::move(pressures), std::move(times), sigma);
-            if (strict) check_rows(rows);
             BatchResult r;
             {
               py::gil_scoped_release release;
+              const auto lock = write_lock(&c);
+              // Checked under the same lock as the insert: nothing is inserted when one fails.
+              // (A py::value_error is a C++ exception until it is raised, with the GIL back.)
+              if (strict) check_rows(*c.impl, rows);
               r = c.impl->insert(rows);
             }
             return batch_dict(r);
@@ -448,6 +458,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
             BatchResult r;
             {
               py::gil_scoped_release release;
+              const auto lock = write_lock(&c);
               r = c.impl->insert(contacts);
             }
             return batch_dict(r);
@@ -461,7 +472,12 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
             k.position = position;
             k.covariance = isotropic_covariance(sigma);
             k.time = time;
-            const InsertResult r = c.impl->insert(k);
+            InsertResult r;
+            {
+              py::gil_scoped_release release;
+              const auto lock = write_lock(&c);
+              r = c.impl->insert(k);
+            }
             if (r.status == InsertStatus::rejected) {
               throw py::value_error("contact: " + std::string(to_string(r.defect)));
             }
@@ -480,6 +496,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
             BatchResult r;
             {
               py::gil_scoped_release release;
+              const auto lock = write_lock(&c);
               r = c.impl->insert(cs);
             }
             return batch_dict(r);
@@ -492,6 +509,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
       .def_property_readonly(
           "means",
           [](const PyContactCloud& c) {
+            const auto lock = read_lock(&c);
             ArrayD out({static_cast<py::ssize_t>(c.impl->size()), py::ssize_t{3}});
             c.impl->means(out.mutable_data());
             return out;
@@ -500,6 +518,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
       .def_property_readonly(
           "covariances",
           [](const PyContactCloud& c) {
+            const auto lock = read_lock(&c);
             ArrayD out({static_cast<py::ssize_t>(c.impl->size()), py::ssize_t{3}, py::ssize_t{3}});
             c.impl->covariances(out.mutable_data());
             return out;
@@ -508,6 +527,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
       .def_property_readonly(
           "observations",
           [](const PyContactCloud& c) {
+            const auto lock = read_lock(&c);
             py::array_t<std::uint32_t> out(static_cast<py::ssize_t>(c.impl->size()));
             c.impl->observations(out.mutable_data());
             return out;
@@ -516,6 +536,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
       .def_property_readonly(
           "last_times",
           [](const PyContactCloud& c) {
+            const auto lock = read_lock(&c);
             py::array_t<double> out(static_cast<py::ssize_t>(c.impl->size()));
             c.impl->last_times(out.mutable_data());
             return out;
@@ -525,6 +546,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
           "confident",
           [](const PyContactCloud& c, std::uint32_t min_observations, double max_sigma,
              double max_normal_sigma) {
+            const auto lock = read_lock(&c);
             py::array_t<bool> out(static_cast<py::ssize_t>(c.impl->size()));
             for (std::size_t i = 0; i < c.impl->size(); ++i) {
               out.mutable_data()[i] =
@@ -542,6 +564,7 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
           "to_point_cloud",
           [](const PyContactCloud& c, std::uint32_t min_observations, double max_sigma,
              double max_normal_sigma) {
+            const auto lock = read_lock(&c);
             return c.impl->to_point_cloud(min_observations, max_sigma, max_normal_sigma);
           },
           py::kw_only(), py::arg("min_observations") = 1,
@@ -549,12 +572,30 @@ strict=False invalid contacts are skipped and counted. Returns {'added', 'fused'
           py::arg("max_normal_sigma") = std::numeric_limits<double>::infinity(),
           "The confident points as a PointCloud with fields 'observations', 'cov_xx' .. "
           "'cov_zz', 'last_time' (and normals with the surfel policy).")
-      .def("clear", [](PyContactCloud& c) { c.impl->clear(); })
+      .def("clear",
+           [](PyContactCloud& c) {
+             const auto lock = write_lock(&c);
+             c.impl->clear();
+           })
       .def(
-          "reserve", [](PyContactCloud& c, std::size_t n) { c.impl->reserve(n); }, py::arg("n"))
+          "reserve",
+          [](PyContactCloud& c, std::size_t n) {
+            const auto lock = write_lock(&c);
+            try {
+              c.impl->reserve(n);
+            } catch (const std::length_error&) {
+              throw py::value_error("reserve: n = " + std::to_string(n) +
+                                    " points is more than a cloud can hold");
+            }
+          },
+          py::arg("n"), "Makes room for n points (MemoryError when memory runs out).")
       .def_property_readonly("memory_bytes",
-                             [](const PyContactCloud& c) { return c.impl->memory_bytes(); })
+                             [](const PyContactCloud& c) {
+                               const auto lock = read_lock(&c);
+                               return c.impl->memory_bytes();
+                             })
       .def("__repr__", [](const PyContactCloud& c) {
+        const auto lock = read_lock(&c);
         return "ContactCloud(policy='" + c.policy + "', index='" + c.index + "', " +
                std::to_string(c.impl->size()) + " points)";
       });

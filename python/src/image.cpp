@@ -400,6 +400,7 @@ gradient_threshold) and the feature vectors.)doc")
             im::Recognition out;
             {
               py::gil_scoped_release release;
+              const auto lock = write_lock(&r);  // its workspace changes (common.hpp)
               out = r.recognizer.recognize(ImageMap(image.data(), image.shape(0), image.shape(1)));
             }
             raise_unless_ok(out);
@@ -414,6 +415,7 @@ gradient_threshold) and the feature vectors.)doc")
             std::vector<im::Recognition> all;
             {
               py::gil_scoped_release release;
+              const auto lock = read_lock(&r);
               all = im::recognize_all(
                   r.recognizer, static_cast<std::size_t>(n),
                   [&](std::size_t i) { return frame(images, f, static_cast<py::ssize_t>(i)); },

@@ -20,7 +20,7 @@ py::array_t<std::uint32_t> triangles_array(const Triangles& t) {
 }
 
 Triangles triangles_from(
-    const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& a,
+    const ArrayI64& a,
     std::size_t vertices) {
   require_shape(a, {-1, 3}, "triangles", "(T, 3)");
   Triangles t(static_cast<std::size_t>(a.shape(0)));
@@ -62,7 +62,7 @@ write leaves no partial file.)doc");
   m.def(
       "write_ply",
       [](const std::string& path, const Cloud& cloud,
-         const std::optional<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>>&
+         const std::optional<ArrayI64>&
              triangles,
          bool binary) {
         const Triangles t = triangles ? triangles_from(*triangles, cloud.size()) : Triangles{};

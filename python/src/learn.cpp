@@ -80,6 +80,8 @@ void evaluation_options(Options& opt, std::uint64_t seed, bool grouped, double s
 template <class C>
 py::class_<C> bind_classifier(py::module_& m, const char* name, const char* doc) {
   py::class_<C> cls(m, name, doc);
+  // Every method takes the model's lock (common.hpp, object_mutex): fit exclusively, the rest
+  // shared; the GIL is released before the lock is taken and taken back after it is released.
   cls.def(
          "fit",
          [](C& c, ArrayD x, ArrayI y, std::optional<ArrayI> groups) -> C& {
@@ -87,6 +89,7 @@ py::class_<C> bind_classifier(py::module_& m, const char* name, const char* doc)
            Outcome o;
            {
              py::gil_scoped_release release;
+             const auto lock = write_lock(&c);
              o = c.fit(d.view());
            }
            raise_unless_ok(o, true);
@@ -96,19 +99,26 @@ py::class_<C> bind_classifier(py::module_& m, const char* name, const char* doc)
          py::arg("X"), py::arg("y"), py::arg("groups") = py::none(),
          "Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError "
          "for an empty set, non-finite features or one class; RuntimeWarning when an iteration "
-         "cap stopped training (the model is still usable).")
+         "cap stopped training (the model is still usable). Thread-safe: a model being fitted "
+         "is not read meanwhile.")
       .def(
           "predict",
           [](const C& c, const ArrayD& x) {
-            if (c.dims() == 0) throw py::value_error(std::string(name_of<C>()) + ": not fitted");
+            const auto fitted = [&] {
+              if (c.dims() == 0) throw py::value_error(std::string(name_of<C>()) + ": not fitted");
+            };
             if (x.ndim() == 1) {
+              const auto lock = read_lock(&c);
+              fitted();
               require_shape(x, {c.dims()}, "X", "(n_features,) or (n_samples, n_features)");
               return py::cast(c.predict(Eigen::Map<const Eigen::VectorXd>(x.data(), x.size())));
             }
-            require_shape(x, {-1, c.dims()}, "X", "(n_samples, n_features)");
-            py::array_t<int> out(x.shape(0));
+            py::array_t<int> out(x.ndim() == 2 ? x.shape(0) : 0);
             {
               py::gil_scoped_release release;
+              const auto lock = read_lock(&c);
+              fitted();
+              require_shape(x, {-1, c.dims()}, "X", "(n_samples, n_features)");
               for (py::ssize_t i = 0; i < x.shape(0); ++i) {
                 out.mutable_data()[i] =
                     c.predict(Eigen::Map<const Eigen::VectorXd>(x.data() + i * c.dims(), c.dims()));
@@ -120,11 +130,20 @@ py::class_<C> bind_classifier(py::module_& m, const char* name, const char* doc)
       .def(
           "decision_function",
           [](const C& c, const ArrayD& x) {
-            if (c.dims() == 0) throw py::value_error(std::string(name_of<C>()) + ": not fitted");
-            require_shape(x, {-1, c.dims()}, "X", "(n_samples, n_features)");
-            const auto k = static_cast<py::ssize_t>(c.classes().size());
-            ArrayD out({x.shape(0), k});
+            py::ssize_t k = 0;
+            {
+              const auto lock = read_lock(&c);
+              if (c.dims() == 0) throw py::value_error(std::string(name_of<C>()) + ": not fitted");
+              k = static_cast<py::ssize_t>(c.classes().size());
+            }
+            ArrayD out({x.ndim() == 2 ? x.shape(0) : 0, k});
             py::gil_scoped_release release;
+            const auto lock = read_lock(&c);
+            require_shape(x, {-1, c.dims()}, "X", "(n_samples, n_features)");
+            if (static_cast<py::ssize_t>(c.classes().size()) != k) {
+              throw py::value_error(std::string(name_of<C>()) +
+                                    ": the model was fitted again during the call");
+            }
             for (py::ssize_t i = 0; i < x.shape(0); ++i) {
               Eigen::Map<Eigen::VectorXd> row(out.mutable_data() + i * k, k);
               c.decision(Eigen::Map<const Eigen::VectorXd>(x.data() + i * c.dims(), c.dims()), row);
@@ -135,11 +154,15 @@ py::class_<C> bind_classifier(py::module_& m, const char* name, const char* doc)
       .def_property_readonly(
           "classes_",
           [](const C& c) {
+            const auto lock = read_lock(&c);
             const auto cl = c.classes();
             return vector_array(std::vector<int>(cl.begin(), cl.end()));
           },
           "labels in the model's order")
-      .def_property_readonly("n_features_in_", [](const C& c) { return c.dims(); });
+      .def_property_readonly("n_features_in_", [](const C& c) {
+        const auto lock = read_lock(&c);
+        return c.dims();
+      });
   return cls;
 }
 
@@ -190,23 +213,39 @@ files.)doc");
            py::arg("seed") = 1, py::arg("class_weights") = std::map<int, double>{},
            py::arg("threads") = 0u)
       .def_property_readonly(
-          "coef_", [](const ln::LinearSvm& s) { return s.weights(); },
+          "coef_",
+          [](const ln::LinearSvm& s) {
+            const auto lock = read_lock(&s);
+            return std::decay_t<decltype(s.weights())>(s.weights());
+          },
           "(n_problems, n_features) weights; one row for two classes")
       .def_property_readonly(
           "intercept_",
           [](const ln::LinearSvm& s) {
+            const auto lock = read_lock(&s);
             return Eigen::VectorXd(s.bias() >= 0 ? Eigen::VectorXd(s.bias() * s.bias_weights())
                                                  : Eigen::VectorXd::Zero(s.bias_weights().size()));
           },
           "(n_problems,) intercepts: bias * bias weight")
       .def_property_readonly("solver_type", &ln::LinearSvm::solver_type)
       .def_property_readonly("iterations",
-                             [](const ln::LinearSvm& s) { return s.info().iterations; })
+                             [](const ln::LinearSvm& s) {
+                               const auto lock = read_lock(&s);
+                               return s.info().iterations;
+                             })
       .def_property_readonly(
-          "objective", [](const ln::LinearSvm& s) { return s.info().objective; },
+          "objective",
+          [](const ln::LinearSvm& s) {
+            const auto lock = read_lock(&s);
+            return s.info().objective;
+          },
           "final dual objective per binary problem")
       .def(
-          "to_liblinear", [](const ln::LinearSvm& s) { return s.save(); },
+          "to_liblinear",
+          [](const ln::LinearSvm& s) {
+            const auto lock = read_lock(&s);
+            return s.save();
+          },
           "the model as LIBLINEAR model-file text")
       .def_static(
           "from_liblinear", [](const std::string& text) { return ln::LinearSvm::load(text); },

@@ -269,13 +269,19 @@ point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its 
             t.normal_neighbors = normal_neighbors;
             Cloud c = cloud_from(points, normals, "points");
             py::gil_scoped_release release;
+            const auto lock = write_lock(&lib);  // common.hpp: object_mutex
             lib.add(std::move(name), std::move(c), t);
           },
           py::arg("name"), py::arg("points"), py::arg("normals") = py::none(), py::kw_only(),
           py::arg("normal_neighbors") = 12, "Adds a model: (N, 3) points [m], optional normals.")
-      .def("__len__", &reg::ObjectLibrary<double>::size)
+      .def("__len__",
+           [](const reg::ObjectLibrary<double>& lib) {
+             const auto lock = read_lock(&lib);
+             return lib.size();
+           })
       .def_property_readonly("names",
                              [](const reg::ObjectLibrary<double>& lib) {
+                               const auto lock = read_lock(&lib);
                                std::vector<std::string> out;
                                for (std::size_t i = 0; i < lib.size(); ++i)
                                  out.push_back(lib.name(i));
@@ -286,6 +292,7 @@ point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its 
           [](const reg::ObjectLibrary<double>& lib, const ArrayD& points) {
             Cloud c = cloud_from(points, std::nullopt, "points");
             py::gil_scoped_release release;
+            const auto lock = read_lock(&lib);
             return lib.recognize(c);
           },
           py::arg("points"),

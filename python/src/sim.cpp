@@ -184,7 +184,7 @@ palm-grasp pressure-image synthesiser.)doc");
                                     "volume hierarchy.");
   mesh.def(
       py::init([](const ArrayD& vertices,
-                  const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>&
+                  const ArrayI64&
                       triangles) {
         std::vector<Vec3d> v = points_from(vertices, "vertices");
         require_shape(triangles, {-1, 3}, "triangles", "(T, 3)");

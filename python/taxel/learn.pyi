@@ -66,7 +66,7 @@ class Knn:
     @property
     def classes_(self) -> numpy.typing.NDArray[numpy.int32]: ...
     def decision_function(self, X: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(n_samples, n_classes) decision values, columns in classes_ order."""
-    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.Knn: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable)."""
+    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.Knn: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable). Thread-safe: a model being fitted is not read meanwhile."""
     @property
     def n_features_in_(self) -> int: ...
     def predict(self, X: numpy.typing.NDArray[numpy.float64]) -> typing.Union[int, numpy.typing.NDArray[numpy.int32]]: """Labels of the rows of X (an int for a single 1-D sample)."""
@@ -78,7 +78,7 @@ class Lda:
     @property
     def classes_(self) -> numpy.typing.NDArray[numpy.int32]: ...
     def decision_function(self, X: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(n_samples, n_classes) decision values, columns in classes_ order."""
-    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.Lda: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable)."""
+    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.Lda: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable). Thread-safe: a model being fitted is not read meanwhile."""
     @property
     def n_features_in_(self) -> int: ...
     def predict(self, X: numpy.typing.NDArray[numpy.float64]) -> typing.Union[int, numpy.typing.NDArray[numpy.int32]]: """Labels of the rows of X (an int for a single 1-D sample)."""
@@ -92,7 +92,7 @@ class LinearSvm:
     @property
     def coef_(self) -> numpy.typing.NDArray[numpy.float64]: ...
     def decision_function(self, X: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(n_samples, n_classes) decision values, columns in classes_ order."""
-    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.LinearSvm: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable)."""
+    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.LinearSvm: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable). Thread-safe: a model being fitted is not read meanwhile."""
     @staticmethod
     def from_liblinear(text: str) -> taxel.learn.LinearSvm: """a model from LIBLINEAR model-file text"""
     @property
@@ -118,7 +118,7 @@ class Mlp:
     @property
     def classes_(self) -> numpy.typing.NDArray[numpy.int32]: ...
     def decision_function(self, X: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(n_samples, n_classes) decision values, columns in classes_ order."""
-    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.Mlp: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable)."""
+    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.Mlp: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable). Thread-safe: a model being fitted is not read meanwhile."""
     @property
     def n_features_in_(self) -> int: ...
     def predict(self, X: numpy.typing.NDArray[numpy.float64]) -> typing.Union[int, numpy.typing.NDArray[numpy.int32]]: """Labels of the rows of X (an int for a single 1-D sample)."""
@@ -130,7 +130,7 @@ class RbfSvm:
     @property
     def classes_(self) -> numpy.typing.NDArray[numpy.int32]: ...
     def decision_function(self, X: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]: """(n_samples, n_classes) decision values, columns in classes_ order."""
-    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.RbfSvm: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable)."""
+    def fit(self, X: numpy.typing.NDArray[numpy.float64], y: numpy.typing.NDArray[numpy.int32], groups: typing.Optional[numpy.typing.NDArray[numpy.int32]] = None) -> taxel.learn.RbfSvm: """Trains on X (n_samples, n_features) and integer labels y; returns self. ValueError for an empty set, non-finite features or one class; RuntimeWarning when an iteration cap stopped training (the model is still usable). Thread-safe: a model being fitted is not read meanwhile."""
     @property
     def n_features_in_(self) -> int: ...
     def predict(self, X: numpy.typing.NDArray[numpy.float64]) -> typing.Union[int, numpy.typing.NDArray[numpy.int32]]: """Labels of the rows of X (an int for a single 1-D sample)."""

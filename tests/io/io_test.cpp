@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 #include <taxel/io.hpp>
 
 #if defined(TAXEL_TEST_HAVE_PNG)
@@ -673,4 +674,115 @@ TEST_CASE("image readers refuse images beyond the size limit with the file name"
           "[io][reliability]") {
   CHECK_THROWS_WITH(tio::parse_pgm("P5\n8192 8192\n255\n", "big.pgm"),
                     Contains("big.pgm") && Contains("limit"));
+}
+
+TEST_CASE("write_files: a set is written whole, or none of its files is replaced",
+          "[io][reliability]") {
+  const auto dir = fresh_dir("taxel_write_files_test");
+  const std::string a = (dir / "readings.npy").string(), b = (dir / "poses.csv").string();
+  tio::write_files({{a, "readings 1"}, {b, "poses 1"}});
+  CHECK(tio::read_file(a) == "readings 1");
+  CHECK(tio::read_file(b) == "poses 1");
+  // The second file cannot be written (its folder is missing): the first keeps its old text.
+  const std::string lost = (dir / "missing" / "poses.csv").string();
+  CHECK_THROWS_WITH(tio::write_files({{a, "readings 2"}, {lost, "poses 2"}}),
+                    Contains("missing") && Contains("No such file"));
+  CHECK(tio::read_file(a) == "readings 1");
+  // A file that fills the disk part-way (the size limit stands in for it): neither replaced.
+  struct ::rlimit old {};
+  REQUIRE(::getrlimit(RLIMIT_FSIZE, &old) == 0);
+  const auto previous_handler = std::signal(SIGXFSZ, SIG_IGN);
+  struct ::rlimit small = old;
+  small.rlim_cur = 4096;
+  REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
+  std::string error;
+  try {
+    tio::write_files({{a, "readings 3"}, {b, std::string(100000, 'x')}});
+  } catch (const taxel::IoError& e) {
+    error = e.what();
+  }
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, previous_handler);
+  CHECK_THAT(error, Contains("poses.csv") && Contains("File too large"));
+  CHECK(tio::read_file(a) == "readings 1");
+  CHECK(tio::read_file(b) == "poses 1");
+  CHECK(entries(dir) == 2);  // no temporary left behind
+}
+
+TEST_CASE("LineReader and FileLineReader: LF, CRLF, a lone CR, and a byte-order mark",
+          "[io][reliability]") {
+  const std::string text = "\xEF\xBB\xBF" "a,b\r\nc\rd\n\ne\r";
+  const std::vector<std::string> want{"a,b", "c", "d", "", "e"};
+  std::vector<std::string> got;
+  tio::LineReader lines(text);
+  std::string_view line;
+  while (lines.next(line)) got.emplace_back(line);
+  CHECK(got == want);
+  CHECK(lines.line_number() == 5);
+
+  // The same from a file, with a CRLF split across two blocks of the reader.
+  const auto dir = fresh_dir("taxel_file_line_reader_test");
+  const std::string path = (dir / "lines.txt").string();
+  // The CR is the last byte of the first block, its LF the first of the second.
+  std::string big(tio::FileLineReader::kBlockBytes - 1 - text.size(), 'x');
+  big += "\r\nlast";
+  tio::write_file(path, text + big);
+  tio::FileLineReader file(path);
+  got.clear();
+  while (file.next(line)) got.emplace_back(line);
+  REQUIRE(got.size() == 7);
+  CHECK(std::vector<std::string>(got.begin(), got.begin() + 5) == want);
+  CHECK(got[5] == big.substr(0, big.size() - 6));  // neither the CR nor the LF is part of it
+  CHECK(got[6] == "last");
+  CHECK_THROWS_WITH(tio::FileLineReader((dir / "none.txt").string()), Contains("cannot open"));
+  CHECK_THROWS_WITH(tio::FileLineReader(dir.string()), Contains("folder"));
+}
+
+TEST_CASE("ContactsCsvReader streams what parse_contacts_csv reads, in batches",
+          "[io][reliability]") {
+  std::string text = "\xEF\xBB\xBF" "time,x,y,z,pressure\r";
+  for (int i = 0; i < 1000; ++i) {
+    text += std::to_string(i) + "," + std::to_string(i * 1e-3) + ",0,0,1\r";
+  }
+  const auto dir = fresh_dir("taxel_contacts_reader_test");
+  const std::string path = (dir / "c.csv").string();
+  tio::write_file(path, text);
+  const auto whole = tio::parse_contacts_csv(text);
+  REQUIRE(whole.size() == 1000);
+  CHECK(whole[999].time == 999.0);  // the time column is read despite the mark
+  tio::ContactsCsvReader reader(path);
+  std::vector<taxel::Contact<double>> all, batch;
+  bool more = true;
+  while (more) {
+    batch.clear();
+    more = reader.read(batch, 64);
+    CHECK(batch.size() <= 64);
+    all.insert(all.end(), batch.begin(), batch.end());
+  }
+  REQUIRE(all.size() == whole.size());
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    CHECK(all[i].position == whole[i].position);
+    CHECK(all[i].time == whole[i].time);
+  }
+  // NaN time or pressure: a bad row, with its line and column.
+  CHECK_THROWS_WITH(tio::parse_contacts_csv("time,x,y,z\nnan,0,0,0\n"),
+                    Contains("<csv>:2: column 1: time is not finite"));
+  CHECK_THROWS_WITH(tio::parse_contacts_csv("x,y,z,pressure\n0,0,0,inf\n"),
+                    Contains("<csv>:2: column 4: pressure is not finite"));
+}
+
+TEST_CASE("IoError shows control bytes of its input instead of ending the message there",
+          "[io][reliability]") {
+  const taxel::IoError e("f.csv", std::string("bad cell 'a\0b\nc'", 16), 3);
+  CHECK(std::string(e.what()) == "f.csv:3: bad cell 'a\\x00b\\x0ac'");
+}
+
+TEST_CASE("npy shapes follow Python's tuple grammar", "[io][reliability]") {
+  const std::string one(2, '\0');
+  CHECK(tio::parse_npy_u16(npy("<u2", "(1,)", one)).shape == std::vector<std::size_t>{1});
+  CHECK(tio::parse_npy_u16(npy("<u2", "(1, 1,)", one)).shape == std::vector<std::size_t>{1, 1});
+  for (const char* bad : {"(1,, 1)", "(,)", "(1, ,)", "(,1)"}) {
+    CAPTURE(bad);
+    CHECK_THROWS_WITH(tio::parse_npy_u16(npy("<u2", bad, one)), Contains("is not a tuple of sizes"));
+  }
 }

@@ -115,13 +115,8 @@ class ContactCloud {
   /// Validates `contact`, then fuses it into the nearest point within the association gate
   /// (`gate`; if the policy merges and accepts it) or adds it as a new point.
   InsertResult insert(const Contact<Scalar>& contact) {
-    const ContactDefect defect = check_contact(contact);
-    if (defect != ContactDefect::ok) return {InsertStatus::rejected, 0, defect};
-    if constexpr (requires(const I& ix) { ix.max_coordinate(); }) {
-      if (!(contact.position.cwiseAbs().maxCoeff() <= index_.max_coordinate())) {
-        return {InsertStatus::rejected, 0, ContactDefect::out_of_range};
-      }
-    }
+    const ContactDefect bad = defect(contact);
+    if (bad != ContactDefect::ok) return {InsertStatus::rejected, 0, bad};
     if constexpr (F::kMerges) {
       // The nearest point within the radius is the nearest within any wider gate too, so the
       // wider query runs only when the radius holds none (the index serves the radius best).
@@ -164,6 +159,21 @@ class ContactCloud {
     points_.push_back({state, {1, contact.time}});
     index_.insert(id, contact.position);
     return {InsertStatus::added, id, ContactDefect::ok};
+  }
+
+  /// Why insert would reject `contact` before fusing it (check_contact's defects, or a position
+  /// beyond what the index separates exactly), or ContactDefect::ok. Only an overflow while
+  /// fusing (extreme magnitudes) is found by insert alone. Lets a caller validate a batch
+  /// before inserting any of it.
+  [[nodiscard]] ContactDefect defect(const Contact<Scalar>& contact) const noexcept {
+    const ContactDefect d = check_contact(contact);
+    if (d != ContactDefect::ok) return d;
+    if constexpr (requires(const I& ix) { ix.max_coordinate(); }) {
+      if (!(contact.position.cwiseAbs().maxCoeff() <= index_.max_coordinate())) {
+        return ContactDefect::out_of_range;
+      }
+    }
+    return ContactDefect::ok;
   }
 
   /// The association gate of a valid `contact` [m]: association_radius, widened to

@@ -212,14 +212,22 @@ inline NpyArray parse_npy_header(std::string_view bytes, const std::string& sour
          "shape " + std::string(shape) + " exceeds the limit of " + std::to_string(max_count) +
              " values");
   };
+  // Python's tuple grammar: sizes separated by commas, one trailing comma allowed ("(3,)"),
+  // nothing else empty ("(100,, 1)" and "(,)" are not tuples).
   std::string_view rest = shape.substr(1, shape.size() - 2);
-  while (!rest.empty()) {
+  for (bool more = true; more;) {
     const std::size_t comma = rest.find(',');
     std::string_view item = rest.substr(0, comma);
-    rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+    more = comma != std::string_view::npos;
+    rest = more ? rest.substr(comma + 1) : std::string_view();
     while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
-    if (item.empty()) continue;
+    if (item.empty()) {
+      const bool trailing = !more && !a.shape.empty();  // "(3,)": nothing after the last comma
+      const bool unit = !more && a.shape.empty();       // "()": a scalar
+      if (trailing || unit) break;
+      fail(source, shape_at, "shape " + std::string(shape) + " is not a tuple of sizes");
+    }
     std::uint64_t d = 0;
     for (const char c : item) {
       if (c < '0' || c > '9') {

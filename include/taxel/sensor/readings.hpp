@@ -28,7 +28,8 @@ struct ReadingStack {
   std::vector<std::uint16_t> values;  ///< frames * pads * rows * cols readings
 
   /// The stack of a .npy array of shape (frames, rows, cols) (one pad) or (frames, pads,
-  /// rows, cols). Throws std::invalid_argument for another number of dimensions.
+  /// rows, cols). Throws std::invalid_argument for another number of dimensions, or a pad of
+  /// more than 4096 rows or columns (SensorModel's limit; an empty stack may claim any size).
   static ReadingStack from_npy(io::NpyU16 array) {
     ReadingStack s;
     const auto& d = array.shape;
@@ -41,6 +42,11 @@ struct ReadingStack {
           "readings: expected an array of shape (frames, rows, cols) or (frames, pads, rows, "
           "cols), got " +
           std::to_string(d.size()) + " dimensions");
+    }
+    if (s.rows > 4096 || s.cols > 4096) {
+      throw std::invalid_argument("readings: pads of " + std::to_string(s.rows) + " x " +
+                                  std::to_string(s.cols) +
+                                  " tactels; a sensor model has at most 4096 rows and columns");
     }
     s.values = std::move(array.values);
     return s;
