@@ -12,7 +12,7 @@ namespace taxel {
 
 /// A file or stream could not be read or written, or its content is malformed.
 /// `what()` reads "<source>:<line>: <reason>" or "<source>: byte <offset>: <reason>", with
-/// control characters shown as \xNN so that it stays one whole line.
+/// control characters shown as `\\xNN` so that it stays one whole line.
 class IoError : public std::runtime_error {
  public:
   /// `source` names the file (or stream); `line` is 1-based; `byte_offset` is 0-based.

@@ -20,20 +20,22 @@ namespace taxel::fusion {
 /// sum_i w_i^2 R_i, updated as C <- (1 - w)^2 C + w^2 R. State: 96 bytes (double).
 template <Scalar S>
 struct Average {
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Which average.
   enum class Mode { cumulative, exponential };
   /// Configuration; defaults give the cumulative mean.
   struct Config {
-    Mode mode = Mode::cumulative;
+    Mode mode = Mode::cumulative;  ///< Cumulative or exponential mean.
     S alpha = S(0.1);  ///< weight of the newest contact in `exponential` mode, in (0, 1]
   };
   /// A fused point.
   struct State {
-    Vec3<S> mean;
-    Mat3<S> covariance;
+    Vec3<S> mean;        ///< Estimated surface position [m], world frame.
+    Mat3<S> covariance;  ///< Covariance of the position [m^2].
   };
-  static constexpr bool kMerges = true;
+  static constexpr bool kMerges =
+      true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
 
   Average() = default;
   /// Throws std::invalid_argument when alpha is outside (0, 1] in exponential mode.

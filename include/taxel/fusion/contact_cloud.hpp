@@ -52,16 +52,17 @@ enum class InsertStatus : std::uint8_t {
 /// Outcome of one insert: the status, the point it concerns (added or fused) and, when
 /// rejected, why.
 struct InsertResult {
-  InsertStatus status = InsertStatus::rejected;
+  InsertStatus status =
+      InsertStatus::rejected;                ///< Whether the contact was added, fused or rejected.
   index::PointId id = 0;                     ///< the added or fused point; 0 when rejected
   ContactDefect defect = ContactDefect::ok;  ///< the reason for a rejection
 };
 
 /// Counts of a batch insert.
 struct BatchResult {
-  std::size_t added = 0;
-  std::size_t fused = 0;
-  std::size_t rejected = 0;
+  std::size_t added = 0;     ///< Contacts that started a new point.
+  std::size_t fused = 0;     ///< Contacts fused into an existing point.
+  std::size_t rejected = 0;  ///< Invalid contacts, left out (the cloud unchanged).
 };
 
 /// Fuses a stream of contacts into a compact point cloud. Each valid contact is matched to the
@@ -83,9 +84,13 @@ template <FusionPolicy F = Surfel<double>,
 requires std::same_as<typename F::Scalar, typename I::Scalar>
 class ContactCloud {
  public:
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = typename F::Scalar;
+  /// The fusion policy.
   using Fusion = F;
+  /// The spatial index over the points.
   using Index = I;
+  /// A point's state, as the policy keeps it.
   using State = typename F::State;
 
   /// Configuration of the cloud, its policy and its index.

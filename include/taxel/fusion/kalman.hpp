@@ -29,6 +29,7 @@ inline constexpr double kChi2Dof3P99 = 11.344866730144373;  ///< 99 %
 /// No allocation.
 template <Scalar S>
 struct Kalman {
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Configuration; defaults: no process noise, no gate, P0 = the first contact's R.
   struct Config {
@@ -38,10 +39,11 @@ struct Kalman {
   };
   /// A fused point: the filter's mean and covariance.
   struct State {
-    Vec3<S> mean;
-    Mat3<S> covariance;
+    Vec3<S> mean;        ///< Estimated surface position [m], world frame.
+    Mat3<S> covariance;  ///< Covariance of the position [m^2].
   };
-  static constexpr bool kMerges = true;
+  static constexpr bool kMerges =
+      true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
 
   Kalman() = default;
   /// Throws std::invalid_argument naming the field that is out of range.

@@ -13,17 +13,20 @@ namespace taxel::fusion {
 /// State: 96 bytes (double), 48 (float).
 template <Scalar S>
 struct Raw {
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Raw has nothing to configure.
   struct Config {};
   /// A stored contact.
   struct State {
-    Vec3<S> position;
-    Mat3<S> covariance;
+    Vec3<S> position;    ///< The contact's position [m], world frame.
+    Mat3<S> covariance;  ///< Covariance of the position [m^2].
   };
-  static constexpr bool kMerges = false;
+  static constexpr bool kMerges =
+      false;  ///< Every contact stays a point of its own (FusionPolicy).
 
   Raw() = default;
+  /// Raw has nothing to configure.
   explicit Raw(const Config&) {}
 
   /// The state of a contact.

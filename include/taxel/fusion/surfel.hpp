@@ -59,6 +59,7 @@ namespace taxel::fusion {
 /// the contact. State: 376 bytes (double). No allocation.
 template <Scalar S>
 struct Surfel {
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Configuration; defaults suit tactile pads of a few millimetres pitch.
   struct Config {
@@ -91,12 +92,14 @@ struct Surfel {
     S su[2] = {};     ///< w-weighted sum of u [m]
     S suu[3] = {};    ///< w-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
     // The curvature fit's sums, weighted by v = w k (k <= 1 the slope's share, see share()).
-    S vweight = S(0);          ///< sum of v [1/m^2]
-    S vu[2] = {}, ss[2] = {};  ///< v-weighted sums of u [m] and s [-]
-    S vuu[3] = {};             ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
-    S ssu[4] = {};             ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
+    S vweight = S(0);  ///< sum of v [1/m^2]
+    S vu[2] = {};      ///< v-weighted sum of u [m]
+    S ss[2] = {};      ///< v-weighted sum of s [-]
+    S vuu[3] = {};     ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
+    S ssu[4] = {};     ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
   };
-  static constexpr bool kMerges = true;
+  static constexpr bool kMerges =
+      true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
 
   Surfel() = default;
   /// Throws std::invalid_argument naming the field that is out of range.

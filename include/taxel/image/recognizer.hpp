@@ -43,11 +43,13 @@ concept FeatureClassifier = requires(const C& c, const Eigen::VectorXd& f) {
 /// a threshold (`Gm > Gth`, Gth = 25 on a 0-255 scale).
 struct GradientThreshold {
   double threshold = 25.0;  ///< Gth
+  /// True when the edge features say the object has edges (EdgeDecider).
   [[nodiscard]] bool edged(const Eigen::VectorXd& f) const noexcept { return f(17) > threshold; }
 };
 
 /// The null classifier: no label (-1). Replace with a trained linear model.
 struct NoClassifier {
+  /// No label: -1 (FeatureClassifier).
   [[nodiscard]] int predict(const Eigen::VectorXd& /*features*/) const noexcept { return -1; }
 };
 
@@ -59,10 +61,11 @@ enum class GradientSource {
 
 /// Options of `Recognizer`.
 struct RecognizerConfig {
-  SegmentationConfig segmentation{};
-  GradientSource gradient_source = GradientSource::raw;
-  RecEdgedConfig edged{};
-  RecEdgelessConfig edgeless{};
+  SegmentationConfig segmentation{};  ///< k-means segmentation and high-pressure regions.
+  GradientSource gradient_source =
+      GradientSource::raw;  ///< Which image the contour gradients are taken on.
+  RecEdgedConfig edged{};   ///< True when the edge features say the object has edges (EdgeDecider).
+  RecEdgelessConfig edgeless{};  ///< RecEdgeless's options.
 };
 
 /// Result of one image.
@@ -87,6 +90,7 @@ struct Recognition : Outcome {
 template <EdgeDecider Decider = GradientThreshold, FeatureClassifier Classifier = NoClassifier>
 class Recognizer {
  public:
+  /// A workspace for images of rows x cols. Throws std::invalid_argument for a bad configuration.
   explicit Recognizer(Eigen::Index rows = 32, Eigen::Index cols = 32, RecognizerConfig cfg = {},
                       Decider decider = {}, Classifier classifier = {})
       : rows_((checked_size(rows, cols), rows)),

@@ -69,8 +69,8 @@ enum class HeightSource {
 struct RecEdgelessConfig {
   double background_fraction = 0.5;  ///< rows, then columns, with more background are removed
   int degree = 2;                    ///< polynomial degree of the column fit, 0..6 (paper: unknown)
-  Healing healing = Healing::linear;
-  HeightSource source = HeightSource::raw;
+  Healing healing = Healing::linear;  ///< Fill holes of the reconstruction from their neighbours.
+  HeightSource source = HeightSource::raw;  ///< The image the surface is fitted to.
 
   /// Throws std::invalid_argument naming the bad field.
   void validate() const {
@@ -88,6 +88,7 @@ struct RecEdgelessConfig {
 /// Not thread-safe (a reused workspace); one per thread.
 class Reconstructor {
  public:
+  /// A workspace for images of rows x cols. Throws std::invalid_argument for a bad configuration.
   Reconstructor(RecEdgedConfig edged = {}, RecEdgelessConfig edgeless = {}, Eigen::Index rows = 32,
                 Eigen::Index cols = 32)
       : edged_(edged), edgeless_(edgeless) {

@@ -60,6 +60,7 @@ struct RegionProps {
 /// Not thread-safe (a reused workspace); one per thread.
 class RegionAnalyzer {
  public:
+  /// A workspace for masks up to rows x cols (it grows for larger ones).
   explicit RegionAnalyzer(RegionPropsOptions opt = {}, Eigen::Index rows = 32,
                           Eigen::Index cols = 32)
       : opt_(opt), components_((detail::checked_pixels("RegionAnalyzer", rows, cols), rows), cols) {

@@ -18,11 +18,13 @@ namespace taxel::index {
 template <Scalar S>
 class BruteForce {
  public:
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// BruteForce has nothing to configure.
   struct Config {};
 
   BruteForce() = default;
+  /// BruteForce has nothing to configure.
   explicit BruteForce(const Config&) {}
 
   /// Adds point `p` with a new `id`.

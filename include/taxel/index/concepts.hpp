@@ -20,9 +20,10 @@ using PointId = std::uint32_t;
 /// A point found by a query: its id and its squared Euclidean distance to the query [m^2].
 template <Scalar S>
 struct Neighbor {
-  PointId id = 0;
-  S squared_distance = S(0);
+  PointId id = 0;             ///< Id of the stored point.
+  S squared_distance = S(0);  ///< Squared distance to the query [m^2].
 
+  /// Equal ids and distances.
   friend bool operator==(const Neighbor&, const Neighbor&) = default;
 };
 

@@ -28,12 +28,14 @@ namespace taxel::index {
 template <Scalar S>
 class DynamicKdTree {
  public:
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Build parameters.
   struct Config {
     std::size_t leaf_size = 10;  ///< maximum points per leaf, >= 1
   };
 
+  /// An empty index. Throws std::invalid_argument for a bad configuration.
   explicit DynamicKdTree(const Config& config = {}) : config_(config) {
     if (config.leaf_size == 0) {
       throw std::invalid_argument("DynamicKdTree::Config::leaf_size must be >= 1");

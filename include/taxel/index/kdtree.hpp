@@ -141,6 +141,7 @@ struct IdentityIds {
 template <Scalar S>
 class KdTree {
  public:
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Build parameters.
   struct Config {

@@ -29,6 +29,7 @@ namespace taxel::index {
 template <Scalar S>
 class UniformGrid {
  public:
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Build parameters.
   struct Config {
@@ -202,7 +203,7 @@ class UniformGrid {
 
   /// The answer of nearest_within(q, r, hint), and how far q may move and keep it.
   struct Stable {
-    Neighbor<S> nearest;
+    Neighbor<S> nearest;  ///< The nearest point.
     /// Every query within this distance of q [m] has the same nearest point (not strictly
     /// tied with another), allowing for the rounding of the distances: with d the answer's
     /// distance and c a lower bound on every other point's, a query moved by less than

@@ -39,6 +39,7 @@ namespace taxel::index {
 template <Scalar S>
 class VoxelHash {
  public:
+  /// The floating-point type of positions and covariances (float or double).
   using Scalar = S;
   /// Tuning knobs; defaults suit fusion.
   struct Config {

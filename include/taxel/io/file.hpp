@@ -26,6 +26,7 @@ namespace taxel::io {
 /// the start is skipped (spreadsheet programs write one). The text readers share it.
 class LineReader {
  public:
+  /// Reads `text`, which must outlive the reader.
   explicit LineReader(std::string_view text) noexcept : text_(text) {
     if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;
   }
@@ -64,7 +65,8 @@ class LineReader {
 /// `max_line_bytes` (64 MiB) is refused. Throws IoError naming the file.
 class FileLineReader {
  public:
-  static constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
+  static constexpr std::size_t kBlockBytes = std::size_t{1}
+                                             << 20;  ///< Bytes read from the file at a time.
 
   /// Opens `path`; `source` names it in messages (default: the path).
   explicit FileLineReader(const std::string& path, std::string source = {},
@@ -77,8 +79,9 @@ class FileLineReader {
     if (::fstat(fd_, &st) != 0 || S_ISDIR(st.st_mode)) {
       const int err = errno;
       ::close(fd_);
-      throw IoError(source_, S_ISDIR(st.st_mode) ? std::string("is a folder, not a file")
-                                                 : std::string("cannot stat: ") + std::strerror(err));
+      throw IoError(source_, S_ISDIR(st.st_mode)
+                                 ? std::string("is a folder, not a file")
+                                 : std::string("cannot stat: ") + std::strerror(err));
     }
   }
   FileLineReader(const FileLineReader&) = delete;

@@ -17,17 +17,19 @@ namespace taxel::io {
 
 /// An 8-bit RGB picture, row-major, 3 bytes per pixel.
 struct RgbImage {
-  Eigen::Index rows = 0;
-  Eigen::Index cols = 0;
+  Eigen::Index rows = 0;           ///< Height [px].
+  Eigen::Index cols = 0;           ///< Width [px].
   std::vector<std::uint8_t> data;  ///< rows * cols * 3 bytes
 
   RgbImage() = default;
+  /// A picture of r x c pixels, each of grey level `fill`.
   RgbImage(Eigen::Index r, Eigen::Index c, std::uint8_t fill = 255)
       : rows(r), cols(c), data(static_cast<std::size_t>(r * c * 3), fill) {}
   /// Pointer to the 3 bytes of pixel (r, c).
   std::uint8_t* at(Eigen::Index r, Eigen::Index c) {
     return data.data() + static_cast<std::size_t>((r * cols + c) * 3);
   }
+  /// Pointer to the 3 bytes of pixel (r, c).
   [[nodiscard]] const std::uint8_t* at(Eigen::Index r, Eigen::Index c) const {
     return data.data() + static_cast<std::size_t>((r * cols + c) * 3);
   }

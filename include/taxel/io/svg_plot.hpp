@@ -22,22 +22,22 @@ namespace taxel::io {
 
 /// One line of a plot. Points with a non-finite coordinate are left out (the line breaks).
 struct PlotSeries {
-  std::string name;
-  std::vector<double> x;
-  std::vector<double> y;
+  std::string name;       ///< Legend text.
+  std::vector<double> x;  ///< Abscissae.
+  std::vector<double> y;  ///< Ordinates, one per abscissa.
 };
 
 /// A line plot. Axis limits default to the data's range, widened to whole ticks.
 struct LinePlot {
-  std::string title;
-  std::string x_label;
-  std::string y_label;
-  std::vector<PlotSeries> series;
-  bool reverse_x = false;  ///< x decreases to the right (e.g. falling SNR)
+  std::string title;               ///< Title above the picture.
+  std::string x_label;             ///< Label of the x axis, with its unit.
+  std::string y_label;             ///< Label of the y axis, with its unit.
+  std::vector<PlotSeries> series;  ///< The lines.
+  bool reverse_x = false;          ///< x decreases to the right (e.g. falling SNR)
   double y_min = std::numeric_limits<double>::quiet_NaN();  ///< NaN: from the data
   double y_max = std::numeric_limits<double>::quiet_NaN();  ///< NaN: from the data
-  int width = 640;
-  int height = 400;
+  int width = 640;                                          ///< [px]
+  int height = 400;                                         ///< [px]
 };
 
 namespace detail {
@@ -217,15 +217,15 @@ inline std::string render_svg(const LinePlot& plot) {
 
 /// A view of a point cloud for render_cloud_svg.
 struct CloudView {
-  std::string title;
+  std::string title;            ///< Title above the picture.
   std::string value_label;      ///< what the colour shows, with its unit
   double azimuth_deg = 35.0;    ///< rotation about the world z axis
   double elevation_deg = 25.0;  ///< tilt of the view above the x-y plane
   double point_radius = 2.2;    ///< [px]
-  int width = 420;
-  int height = 360;
+  int width = 420;              ///< [px]
+  int height = 360;             ///< [px]
   double value_min = std::numeric_limits<double>::quiet_NaN();  ///< NaN: from the data
-  double value_max = std::numeric_limits<double>::quiet_NaN();
+  double value_max = std::numeric_limits<double>::quiet_NaN();  ///< NaN: from the data
 };
 
 /// An SVG picture of `points` seen orthographically from (azimuth, elevation), far points drawn

@@ -27,9 +27,9 @@ using SampleRef = Eigen::Ref<const Eigen::VectorXd>;
 /// A non-owning view of a labelled data set: `x` has one row per sample and `y` one label per
 /// row. `groups` is empty or holds one group id per row (subject, recording).
 struct DatasetView {
-  Eigen::Ref<const FeatureMatrix> x;
-  std::span<const int> y;
-  std::span<const int> groups{};
+  Eigen::Ref<const FeatureMatrix> x;  ///< Features, one sample per row.
+  std::span<const int> y;             ///< One label per row.
+  std::span<const int> groups{};      ///< Empty, or one group id per row.
 
   /// Number of samples.
   [[nodiscard]] Eigen::Index rows() const noexcept { return x.rows(); }

@@ -28,9 +28,9 @@ enum class KnnWeighting {
 
 /// Options of Knn.
 struct KnnConfig {
-  int k = 5;  ///< neighbours, >= 1
-  KnnMetric metric = KnnMetric::euclidean;
-  KnnWeighting weighting = KnnWeighting::uniform;
+  int k = 5;                                       ///< neighbours, >= 1
+  KnnMetric metric = KnnMetric::euclidean;         ///< Distance between samples.
+  KnnWeighting weighting = KnnWeighting::uniform;  ///< How neighbours vote.
 };
 
 /// k nearest neighbours; ties in distance go to the earlier training sample, ties in votes to
@@ -63,12 +63,14 @@ class Knn {
     return o;
   }
 
+  /// One decision value per class of sample `x` into `out`, in classes() order (Classifier).
   template <class D = void>
   void decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     detail::check_sample(x, dims(), "Knn");
     vote(x, out);
     out /= out.sum();
   }
+  /// The label of sample `x` (Classifier).
   template <class D = void>
   [[nodiscard]] int predict(const Deferred<SampleRef, D>& x) const {
     using VectorXd = Deferred<Eigen::VectorXd, D>;
@@ -81,7 +83,9 @@ class Knn {
     votes.maxCoeff(&best);
     return classes_[static_cast<std::size_t>(best)];
   }
+  /// Labels in the model's order (Classifier); empty before fit.
   [[nodiscard]] std::span<const int> classes() const noexcept { return classes_; }
+  /// Number of features a sample has; 0 before fit (Classifier).
   [[nodiscard]] Eigen::Index dims() const noexcept { return x_.cols(); }
 
  private:

@@ -40,6 +40,7 @@ class Lda {
     }
   }
 
+  /// Trains on `d`; the outcome says ok, not_converged or why it could not (Classifier).
   template <class D = void>
   Outcome fit(const Deferred<DatasetView, D>& d) {
     using MatrixXd = Deferred<Eigen::MatrixXd, D>;
@@ -103,11 +104,13 @@ class Lda {
     return o;
   }
 
+  /// One decision value per class of sample `x` into `out`, in classes() order (Classifier).
   template <class D = void>
   void decision(const Deferred<SampleRef, D>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     detail::check_sample(x, dims(), "Lda");
     out = w_ * x + b_;
   }
+  /// The label of sample `x` (Classifier).
   template <class D = void>
   [[nodiscard]] int predict(const Deferred<SampleRef, D>& x) const {
     detail::check_sample(x, dims(), "Lda");
@@ -122,7 +125,9 @@ class Lda {
     }
     return classes_[static_cast<std::size_t>(best)];
   }
+  /// Labels in the model's order (Classifier); empty before fit.
   [[nodiscard]] std::span<const int> classes() const noexcept { return classes_; }
+  /// Number of features a sample has; 0 before fit (Classifier).
   [[nodiscard]] Eigen::Index dims() const noexcept { return w_.cols(); }
   /// Class means, one row per class.
   [[nodiscard]] const Eigen::MatrixXd& means() const noexcept { return means_; }

@@ -27,17 +27,17 @@ enum class MlpOptimizer { adam, sgd };
 
 /// Options of Mlp. Scale the features first (Scaled<StandardScaler, Mlp>).
 struct MlpConfig {
-  std::vector<int> hidden{32};  ///< one or two hidden layer widths, each >= 1
-  MlpActivation activation = MlpActivation::tanh;
-  MlpOptimizer optimizer = MlpOptimizer::adam;
-  double learning_rate = 1e-2;  ///< step size, > 0
-  double momentum = 0.9;        ///< SGD momentum, [0, 1)
-  double l2 = 1e-4;             ///< weight decay on the weights (not the biases), >= 0
-  int epochs = 200;             ///< passes over the training set, >= 1
-  int batch_size = 32;          ///< samples per step, >= 1
-  double tolerance = 1e-5;      ///< stop when the epoch loss improves less for `patience` epochs
-  int patience = 10;            ///< epochs without improvement before stopping
-  std::uint64_t seed = 1;       ///< initial weights and batch order
+  std::vector<int> hidden{32};                     ///< one or two hidden layer widths, each >= 1
+  MlpActivation activation = MlpActivation::tanh;  ///< Activation of the hidden layers.
+  MlpOptimizer optimizer = MlpOptimizer::adam;     ///< Adam or SGD with momentum.
+  double learning_rate = 1e-2;                     ///< step size, > 0
+  double momentum = 0.9;                           ///< SGD momentum, [0, 1)
+  double l2 = 1e-4;         ///< weight decay on the weights (not the biases), >= 0
+  int epochs = 200;         ///< passes over the training set, >= 1
+  int batch_size = 32;      ///< samples per step, >= 1
+  double tolerance = 1e-5;  ///< stop when the epoch loss improves less for `patience` epochs
+  int patience = 10;        ///< epochs without improvement before stopping
+  std::uint64_t seed = 1;   ///< initial weights and batch order
 };
 
 /// Multi-layer perceptron classifier; decision values are class probabilities. Models
@@ -168,6 +168,7 @@ class Mlp {
     }
     out = a.col(0);
   }
+  /// The label of sample `x` (Classifier).
   template <class = void>
   [[nodiscard]] int predict(const SampleRef& x) const {
     Eigen::VectorXd p(static_cast<Eigen::Index>(classes_.size()));
@@ -176,7 +177,9 @@ class Mlp {
     p.maxCoeff(&best);
     return classes_[static_cast<std::size_t>(best)];
   }
+  /// Labels in the model's order (Classifier); empty before fit.
   [[nodiscard]] std::span<const int> classes() const noexcept { return classes_; }
+  /// Number of features a sample has; 0 before fit (Classifier).
   [[nodiscard]] Eigen::Index dims() const noexcept { return w_.empty() ? 0 : w_[0].cols(); }
   /// Epochs run by the last fit.
   [[nodiscard]] int epochs() const noexcept { return epochs_; }

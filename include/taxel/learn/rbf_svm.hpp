@@ -60,6 +60,7 @@ class RbfSvm {
       bad("max_iterations", static_cast<double>(cfg.max_iterations), "[0, inf)");
   }
 
+  /// Trains on `d`; the outcome says ok, not_converged or why it could not (Classifier).
   template <class D = void>
   Outcome fit(const Deferred<DatasetView, D>& d) {
     Outcome o = validate_training_set(d, "RbfSvm");
@@ -170,6 +171,7 @@ class RbfSvm {
       }
     }
   }
+  /// The label of sample `x` (Classifier).
   template <class D = void>
   [[nodiscard]] int predict(const Deferred<SampleRef, D>& x) const {
     using VectorXd = Deferred<Eigen::VectorXd, D>;
@@ -181,7 +183,9 @@ class RbfSvm {
     }
     return classes_[static_cast<std::size_t>(best)];
   }
+  /// Labels in the model's order (Classifier); empty before fit.
   [[nodiscard]] std::span<const int> classes() const noexcept { return classes_; }
+  /// Number of features a sample has; 0 before fit (Classifier).
   [[nodiscard]] Eigen::Index dims() const noexcept { return sv_.cols(); }
   /// Support vectors (one row each), in training order.
   [[nodiscard]] const FeatureMatrix& support_vectors() const noexcept { return sv_; }

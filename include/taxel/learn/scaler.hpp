@@ -41,6 +41,7 @@ class AffineScaler {
   [[nodiscard]] Eigen::Index dims() const noexcept { return offset_.size(); }
 
  protected:
+  /// Throws unless the scaler is fitted and a sample has dims() features.
   template <class = void>
   void check(Eigen::Index n) const {
     if (dims() == 0) throw std::logic_error("scaler: transform before fit");
@@ -49,6 +50,7 @@ class AffineScaler {
                                   " features, the scaler was fitted on " + std::to_string(dims()));
     }
   }
+  /// Why `x` cannot be fitted (empty, non-finite), or ok.
   template <class D = void>
   static Outcome check_fit(const Deferred<Eigen::Ref<const FeatureMatrix>, D>& x, const char* who) {
     if (x.rows() == 0 || x.cols() == 0)
@@ -56,8 +58,8 @@ class AffineScaler {
     if (!x.allFinite()) return {Status::invalid_input, std::string(who) + ": non-finite feature"};
     return {};
   }
-  Eigen::VectorXd offset_;
-  Eigen::VectorXd factor_;
+  Eigen::VectorXd offset_;  ///< Subtracted from each feature.
+  Eigen::VectorXd factor_;  ///< Then multiplied with each feature.
 };
 
 /// Standardisation: each feature to zero mean and unit (population) standard deviation over
@@ -114,7 +116,9 @@ class RangeScaler : public AffineScaler {
     }
     return o;
   }
+  /// Smallest scaled value.
   [[nodiscard]] double lower() const noexcept { return lower_; }
+  /// Largest scaled value.
   [[nodiscard]] double upper() const noexcept { return upper_; }
 
  private:
@@ -137,9 +141,11 @@ concept FeatureScaler = std::copy_constructible<S> &&
 template <FeatureScaler S, Classifier C>
 class Scaled {
  public:
+  /// The pipeline of `scaler` then `classifier`.
   explicit Scaled(C classifier = C(), S scaler = S())
       : scaler_(std::move(scaler)), classifier_(std::move(classifier)) {}
 
+  /// Trains on `d`; the outcome says ok, not_converged or why it could not (Classifier).
   Outcome fit(const DatasetView& d) {
     Outcome o = validate_training_set(d, "Scaled");
     if (!o) return o;
@@ -156,24 +162,31 @@ class Scaled {
     }
     return o;
   }
+  /// The label of sample `x` (Classifier).
   [[nodiscard]] int predict(const SampleRef& x) const {
     Eigen::VectorXd s(x.size());
     scaler_.transform(x, s);
     return classifier_.predict(s);
   }
+  /// One decision value per class of sample `x` into `out`, in classes() order (Classifier).
   void decision(const SampleRef& x, Eigen::Ref<Eigen::VectorXd> out) const {
     Eigen::VectorXd s(x.size());
     scaler_.transform(x, s);
     classifier_.decision(s, out);
   }
+  /// Labels in the model's order (Classifier); empty before fit.
   [[nodiscard]] std::span<const int> classes() const noexcept { return classifier_.classes(); }
+  /// Number of features a sample has; 0 before fit (Classifier).
   [[nodiscard]] Eigen::Index dims() const noexcept { return classifier_.dims(); }
+  /// The scaler, as fitted.
   [[nodiscard]] const S& scaler() const noexcept { return scaler_; }
+  /// The classifier, as trained.
   [[nodiscard]] const C& classifier() const noexcept { return classifier_; }
   /// The wrapped classifier's training threads, when it has them (ThreadedTraining).
   [[nodiscard]] unsigned threads() const noexcept requires ThreadedTraining<C> {
     return classifier_.threads();
   }
+  /// Sets the wrapped classifier's training threads (ThreadedTraining).
   void set_threads(unsigned threads) noexcept requires ThreadedTraining<C> {
     classifier_.set_threads(threads);
   }

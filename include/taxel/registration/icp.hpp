@@ -162,9 +162,10 @@ struct Correspondence {
 
 /// Minimises sum w |p - q|^2: closed form (weighted Kabsch with the reflection fix).
 struct PointToPoint {
-  static constexpr std::string_view name = "point-to-point";
-  static constexpr std::size_t min_correspondences = 3;
+  static constexpr std::string_view name = "point-to-point";  ///< Name in messages.
+  static constexpr std::size_t min_correspondences = 3;       ///< Fewest pairs a step needs.
 
+  /// Residual of a pair [m] (for the kernel and the RMSE).
   [[nodiscard]] static double residual(const Correspondence& c) noexcept { return std::sqrt(c.d2); }
 
   /// The update `delta` (applied on the left) minimising the weighted error, or `degenerate`
@@ -229,10 +230,12 @@ struct PointToPoint {
 /// J'J at the target points, rotations scaled by the source's RMS radius, below 1e-6 of the
 /// largest) are not moved and make the result `degenerate`.
 struct PointToPlane {
-  static constexpr std::string_view name = "point-to-plane";
-  static constexpr std::size_t min_correspondences = 6;
-  static constexpr double kFreeDirection = 1e-6;
+  static constexpr std::string_view name = "point-to-plane";  ///< Name in messages.
+  static constexpr std::size_t min_correspondences = 6;       ///< Fewest pairs a step needs.
+  static constexpr double kFreeDirection =
+      1e-6;  ///< Eigenvalues of J'J below this share of the largest leave a direction free.
 
+  /// Residual of a pair [m] (for the kernel and the RMSE).
   template <class D = void>
   [[nodiscard]] static double residual(const Deferred<Correspondence, D>& c) noexcept {
     return std::fabs(c.n.dot(c.p - c.q));
@@ -438,7 +441,9 @@ class Icp {
     return align(target, std::span<const Vec3<S>>(source.points), initial);
   }
 
+  /// The configuration.
   [[nodiscard]] const IcpConfig& config() const noexcept { return cfg_; }
+  /// The robust kernel.
   [[nodiscard]] const Kernel& kernel() const noexcept { return kernel_; }
 
  private:

@@ -18,21 +18,24 @@ concept RobustKernel = requires(const K& k, double r) {
 
 /// Plain least squares: every inlier weighs 1.
 struct NoKernel {
-  static constexpr std::string_view name = "none";
+  static constexpr std::string_view name = "none";  ///< Name in messages.
+  /// Weight of a residual `r` [m] in iteratively reweighted least squares.
   [[nodiscard]] static constexpr double weight(double /*r*/) noexcept { return 1.0; }
 };
 
 /// Huber: quadratic within k, linear beyond (w = k / r).
 struct Huber {
-  static constexpr std::string_view name = "huber";
-  double scale = 1e-3;
+  static constexpr std::string_view name = "huber";  ///< Name in messages.
+  double scale = 1e-3;  ///< Residual [m] where the kernel starts to down-weight.
+  /// Weight of a residual `r` [m] in iteratively reweighted least squares.
   [[nodiscard]] double weight(double r) const noexcept { return r <= scale ? 1.0 : scale / r; }
 };
 
 /// Cauchy (Lorentzian): w = 1 / (1 + (r/k)^2).
 struct Cauchy {
-  static constexpr std::string_view name = "cauchy";
-  double scale = 1e-3;
+  static constexpr std::string_view name = "cauchy";  ///< Name in messages.
+  double scale = 1e-3;  ///< Residual [m] where the kernel starts to down-weight.
+  /// Weight of a residual `r` [m] in iteratively reweighted least squares.
   [[nodiscard]] double weight(double r) const noexcept {
     const double u = r / scale;
     return 1.0 / (1.0 + u * u);
@@ -41,8 +44,9 @@ struct Cauchy {
 
 /// Geman-McClure: w = (k^2 / (k^2 + r^2))^2.
 struct GemanMcClure {
-  static constexpr std::string_view name = "geman-mcclure";
-  double scale = 1e-3;
+  static constexpr std::string_view name = "geman-mcclure";  ///< Name in messages.
+  double scale = 1e-3;  ///< Residual [m] where the kernel starts to down-weight.
+  /// Weight of a residual `r` [m] in iteratively reweighted least squares.
   [[nodiscard]] double weight(double r) const noexcept {
     const double k2 = scale * scale;
     const double d = k2 / (k2 + r * r);
@@ -52,8 +56,9 @@ struct GemanMcClure {
 
 /// Tukey's biweight: w = (1 - (r/k)^2)^2 within k, 0 beyond (outliers drop out entirely).
 struct Tukey {
-  static constexpr std::string_view name = "tukey";
-  double scale = 3e-3;
+  static constexpr std::string_view name = "tukey";  ///< Name in messages.
+  double scale = 3e-3;  ///< Residual [m] where the kernel starts to down-weight.
+  /// Weight of a residual `r` [m] in iteratively reweighted least squares.
   [[nodiscard]] double weight(double r) const noexcept {
     if (r >= scale) return 0.0;
     const double u = r / scale;

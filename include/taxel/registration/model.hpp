@@ -29,7 +29,7 @@ struct ModelSampling {
 
 /// A model cloud and what it was made of.
 struct ModelCloud {
-  PointCloud<double> cloud;
+  PointCloud<double> cloud;    ///< The points (and normals) of the model.
   bool from_surface = false;   ///< sampled from the faces (else: the vertices as read)
   std::size_t triangles = 0;   ///< faces used
   std::size_t degenerate = 0;  ///< faces of zero area, skipped

@@ -82,7 +82,7 @@ struct LibraryConfig {
 
 /// How well one model explains the cloud.
 struct ModelMatch {
-  std::string name;
+  std::string name;                               ///< The model's name.
   std::size_t model = 0;                          ///< index in the library
   double score = 0.0;                             ///< truncated RMS distance [m], lower is better
   double rmse = 0.0;                              ///< ICP inlier RMSE [m]
@@ -97,10 +97,10 @@ struct ModelMatch {
 /// The answer of ObjectLibrary::recognize. `ranking` is sorted by score; `best` is its first
 /// entry's name, or "unknown".
 struct ObjectRecognition : Outcome {
-  std::vector<ModelMatch> ranking;
-  std::string best = "unknown";
-  bool unknown = true;
-  double margin = 0.0;  ///< second score - best score [m] (0 with one model)
+  std::vector<ModelMatch> ranking;  ///< Every model, best first.
+  std::string best = "unknown";     ///< Name of the best model, or "unknown".
+  bool unknown = true;              ///< True when no model fits within the threshold.
+  double margin = 0.0;              ///< second score - best score [m] (0 with one model)
 };
 
 /// Named object models, each preprocessed once into a Target.
@@ -148,9 +148,13 @@ class ObjectLibrary {
     models_.push_back({std::move(name), Target<S>(std::move(model), target)});
   }
 
+  /// Number of models.
   [[nodiscard]] std::size_t size() const noexcept { return models_.size(); }
+  /// The model's name.
   [[nodiscard]] const std::string& name(std::size_t i) const { return models_.at(i).name; }
+  /// The preprocessed target of model `i`.
   [[nodiscard]] const Target<S>& target(std::size_t i) const { return models_.at(i).target; }
+  /// The configuration.
   [[nodiscard]] const LibraryConfig& config() const noexcept { return cfg_; }
 
   /// Ranks every model for `cloud`. Non-finite points are ignored. An empty library or fewer

@@ -37,7 +37,7 @@ struct TargetConfig {
   /// [m] (0: none) and margin around the points' bounding box [m]. Each cell stores the exact
   /// nearest point to its centre, so a lookup errs by at most half a cell diagonal.
   double field_cell = 0.0;
-  double field_margin = 0.02;
+  double field_margin = 0.02;  ///< Margin of the field around the points [m].
   /// Largest number of field cells, >= 1: on a model too large for `field_cell` the cell grows
   /// until the field fits (`Target::field_cell()` tells the edge used), so any legal model gets
   /// a field of bounded memory (4 bytes a cell).

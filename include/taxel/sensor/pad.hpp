@@ -35,7 +35,7 @@ struct PadGeometry {
 /// Gaussian depth noise of `sigma_normal`, rounded and clipped at `levels - 1`; readings below
 /// `threshold` are reported as zero (the noise floor), so they are censored, not missing.
 struct SensorModel {
-  PadGeometry geometry;
+  PadGeometry geometry;            ///< Rows, columns and pitch of the pad.
   double full_scale_depth = 3e-3;  ///< indentation that saturates a tactel [m], in (0, 1]
   int levels = 4096;               ///< reading levels (12-bit like the DSA), >= 2
   int threshold = 8;               ///< readings below this are zero (noise floor), >= 1

@@ -24,7 +24,10 @@ namespace taxel::sensor {
 /// Frames of readings: `frames` x `pads` pads of `rows` x `cols` tactels, row-major, frame
 /// outermost (the layout of a numpy array of shape (frames, pads, rows, cols)).
 struct ReadingStack {
-  std::size_t frames = 0, pads = 0, rows = 0, cols = 0;
+  std::size_t frames = 0;             ///< frames in the stack
+  std::size_t pads = 0;               ///< pads per frame
+  std::size_t rows = 0;               ///< tactel rows per pad
+  std::size_t cols = 0;               ///< tactel columns per pad
   std::vector<std::uint16_t> values;  ///< frames * pads * rows * cols readings
 
   /// The stack of a .npy array of shape (frames, rows, cols) (one pad) or (frames, pads,

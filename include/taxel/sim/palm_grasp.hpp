@@ -69,49 +69,52 @@ constexpr std::string_view to_string(GraspClass c) noexcept {
 
 /// A closed interval for uniform draws.
 struct Range {
-  double lo = 0.0;
-  double hi = 0.0;
+  double lo = 0.0;  ///< Smallest value.
+  double hi = 0.0;  ///< Largest value.
 };
 
 /// Parameters of the palm-grasp model (see the file comment).
 struct PalmGraspConfig {
-  int rows = 32;
-  int cols = 32;
+  int rows = 32;  ///< Image height [tactels].
+  int cols = 32;  ///< Image width [tactels].
   // Hand.
-  int fingers = 4;
-  double finger_width = 4.5;
-  double finger_gap = 1.3;
-  double finger_length = 13.0;
-  double palm_length = 13.0;
-  double scale_sd = 0.08;
-  double rim = 1.5;  ///< soft-tissue rim: pressure tapers to 0 over this many tactels
+  int fingers = 4;              ///< Finger strips.
+  double finger_width = 4.5;    ///< [tactels]
+  double finger_gap = 1.3;      ///< Gap between fingers [tactels].
+  double finger_length = 13.0;  ///< [tactels]
+  double palm_length = 13.0;    ///< [tactels]
+  double scale_sd = 0.08;       ///< Relative standard deviation of the hand size between subjects.
+  double rim = 1.5;             ///< soft-tissue rim: pressure tapers to 0 over this many tactels
   // Placement.
-  double offset_sd = 1.5;        ///< tactels
-  double rotation_sd_deg = 7.0;  ///< hand rotation per grasp
-  double object_angle_deg = 15.0;
-  double object_offset = 3.0;  ///< object axis offset, +- tactels
+  double offset_sd = 1.5;          ///< tactels
+  double rotation_sd_deg = 7.0;    ///< hand rotation per grasp
+  double object_angle_deg = 15.0;  ///< Largest angle of the object's axis to the palm's.
+  double object_offset = 3.0;      ///< object axis offset, +- tactels
   // Force.
+  /// Grip force, relative.
   Range force{0.55, 1.0};
   // Objects.
   double plateau = 0.45;       ///< pressure on a face next to an edge, relative to the ridge
   double overhang = 0.08;      ///< pressure beyond an edge or a cylinder
   Range edge_sigma{1.3, 2.6};  ///< width of an edge ridge
+  /// Width of a two-edged object [tactels].
   Range cuboid_width{7.0, 16.0};
+  /// [tactels]
   Range cylinder_radius{6.0, 15.0};
   // Sensor.
-  double gain = 230.0;
-  double mult_noise = 0.06;
-  double add_noise = 3.0;
-  double dead_tactel_prob = 0.003;
+  double gain = 230.0;              ///< Reading of a full pressure, before noise.
+  double mult_noise = 0.06;         ///< Relative sensor noise.
+  double add_noise = 3.0;           ///< Additive sensor noise [reading units].
+  double dead_tactel_prob = 0.003;  ///< Probability that a tactel reads 0.
 };
 
 /// One hand: the per-subject draw.
 struct Subject {
-  int id = 0;
-  double scale = 1.0;
-  double finger_width = 4.5;
-  double finger_gap = 1.3;
-  double force = 0.8;
+  int id = 0;                             ///< Subject number.
+  double scale = 1.0;                     ///< Hand size, relative.
+  double finger_width = 4.5;              ///< [tactels]
+  double finger_gap = 1.3;                ///< Gap between fingers [tactels].
+  double force = 0.8;                     ///< Grip force, relative.
   double heel = 1.0;                      ///< palm-heel pressure factor
   double pads = 1.0;                      ///< finger-pad pressure factor
   std::array<double, 5> finger_length{};  ///< relative lengths
@@ -119,16 +122,17 @@ struct Subject {
 
 /// One synthetic image with its labels.
 struct PalmGraspSample {
-  image::ImageD image;
-  GraspClass label = GraspClass::planar;
-  int subject = 0;
-  bool right_hand = true;
-  int grasp = 0;
+  image::ImageD image;                    ///< rows x cols pressure readings.
+  GraspClass label = GraspClass::planar;  ///< The object class.
+  int subject = 0;                        ///< The subject's number.
+  bool right_hand = true;                 ///< False for a mirrored left hand.
+  int grasp = 0;                          ///< The grasp's number within its subject and hand.
 };
 
 /// The synthesiser. Throws std::invalid_argument for an impossible configuration.
 class PalmGraspSynth {
  public:
+  /// Draws with `cfg`; equal seeds give equal images.
   explicit PalmGraspSynth(PalmGraspConfig cfg = {}, std::uint64_t seed = 1)
       : cfg_(cfg), seed_(seed) {
     if (cfg.rows < 8 || cfg.cols < 8 || cfg.rows > 1024 || cfg.cols > 1024) {
@@ -276,6 +280,7 @@ class PalmGraspSynth {
     return out;
   }
 
+  /// The configuration.
   [[nodiscard]] const PalmGraspConfig& config() const noexcept { return cfg_; }
 
  private:

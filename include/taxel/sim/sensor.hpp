@@ -28,8 +28,8 @@ namespace taxel::sim {
 /// coordinates.
 template <Shape Sh>
 struct Posed {
-  Sh shape;
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  Sh shape;                                                ///< The shape in its own frame.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< Shape frame -> world.
 
   /// Signed distance of a world point [m].
   double signed_distance(const Vec3d& p) const { return shape.signed_distance(pose.inverse() * p); }

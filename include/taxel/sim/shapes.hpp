@@ -32,21 +32,24 @@ concept Shape = requires(const T& shape, const Vec3d& p) {
 
 /// Sphere of radius `radius` [m] centred at the origin.
 struct Sphere {
-  double radius = 0.04;
+  double radius = 0.04;  ///< [m]
 
   /// Throws std::invalid_argument unless radius is finite and > 0.
   explicit Sphere(double r = 0.04) : radius(r) {
     if (!(r > 0) || !std::isfinite(r)) throw std::invalid_argument("Sphere: radius must be > 0");
   }
+  /// Signed distance of `p` to the surface [m]: negative inside.
   template <class D = void>
   double signed_distance(const Deferred<Vec3d, D>& p) const {
     return p.norm() - radius;
   }
+  /// Unit outward normal of the surface at the point closest to `p`.
   template <class D = void>
   Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const double n = p.norm();
     return n > 0 ? Vec3d(p / n) : Vec3d::UnitZ();
   }
+  /// The point of the surface closest to `p`.
   template <class D = void>
   Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     return radius * normal(p);
@@ -55,8 +58,8 @@ struct Sphere {
 
 /// Capped cylinder along z, centred at the origin: radius and half height [m].
 struct Cylinder {
-  double radius = 0.03;
-  double half_height = 0.05;
+  double radius = 0.03;       ///< [m]
+  double half_height = 0.05;  ///< Half the length along z, caps excluded [m].
 
   /// Throws std::invalid_argument unless both sizes are finite and > 0.
   explicit Cylinder(double r = 0.03, double h = 0.05) : radius(r), half_height(h) {
@@ -64,6 +67,7 @@ struct Cylinder {
       throw std::invalid_argument("Cylinder: radius and half_height must be > 0");
     }
   }
+  /// Signed distance of `p` to the surface [m]: negative inside.
   template <class D = void>
   double signed_distance(const Deferred<Vec3d, D>& p) const {
     const double dr = std::hypot(p.x(), p.y()) - radius;
@@ -71,6 +75,7 @@ struct Cylinder {
     const double out = std::hypot(std::max(dr, 0.0), std::max(dz, 0.0));
     return std::min(std::max(dr, dz), 0.0) + out;
   }
+  /// The point of the surface closest to `p`.
   template <class D = void>
   Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     const double r = std::hypot(p.x(), p.y());
@@ -85,6 +90,7 @@ struct Cylinder {
     const double rc = std::min(r, radius);
     return Vec3d(radial.x() * rc, radial.y() * rc, std::clamp(p.z(), -half_height, half_height));
   }
+  /// Unit outward normal of the surface at the point closest to `p`.
   template <class D = void>
   Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = closest_point(p);
@@ -103,6 +109,7 @@ struct Cylinder {
 
 /// Axis-aligned box centred at the origin with the given half extents [m].
 struct Box {
+  /// Half the side lengths along x, y, z [m].
   Vec3d half_extents{0.04, 0.03, 0.02};
 
   /// Throws std::invalid_argument unless all half extents are finite and > 0.
@@ -111,11 +118,13 @@ struct Box {
       throw std::invalid_argument("Box: half extents must be > 0");
     }
   }
+  /// Signed distance of `p` to the surface [m]: negative inside.
   template <class D = void>
   double signed_distance(const Deferred<Vec3d, D>& p) const {
     const Vec3d d = p.cwiseAbs() - half_extents;
     return d.cwiseMax(0.0).norm() + std::min(d.maxCoeff(), 0.0);
   }
+  /// The point of the surface closest to `p`.
   template <class D = void>
   Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     const Vec3d d = p.cwiseAbs() - half_extents;
@@ -128,6 +137,7 @@ struct Box {
     }
     return p.cwiseMax(-half_extents).cwiseMin(half_extents);
   }
+  /// Unit outward normal of the surface at the point closest to `p`.
   template <class D = void>
   Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = closest_point(p);
@@ -144,8 +154,8 @@ struct Box {
 /// Solid cone along z, centred at the origin: base disc of radius `radius` at z = -h/2, apex at
 /// z = +h/2 (`height` = h) [m].
 struct Cone {
-  double radius = 0.03;
-  double height = 0.06;
+  double radius = 0.03;  ///< [m]
+  double height = 0.06;  ///< From the base (z = 0) to the apex [m].
 
   /// Throws std::invalid_argument unless both sizes are finite and > 0.
   explicit Cone(double r = 0.03, double h = 0.06) : radius(r), height(h) {
@@ -153,15 +163,18 @@ struct Cone {
       throw std::invalid_argument("Cone: radius and height must be > 0");
     }
   }
+  /// Signed distance of `p` to the surface [m]: negative inside.
   template <class D = void>
   double signed_distance(const Deferred<Vec3d, D>& p) const {
     const Section s = section(p);
     return s.inside ? -s.distance : s.distance;
   }
+  /// The point of the surface closest to `p`.
   template <class D = void>
   Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     return lift(p, section(p).closest);
   }
+  /// Unit outward normal of the surface at the point closest to `p`.
   template <class D = void>
   Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Section s = section(p);
@@ -239,6 +252,7 @@ struct Cone {
 /// [-e_min^2 + e_min |y_min|, |e o y| - e_min^2] converges monotonically (Eberly, "Distance
 /// from a point to an ellipse, an ellipsoid, or a hyperellipsoid", Geometric Tools, 2013).
 struct Ellipsoid {
+  /// Along x, y, z [m].
   Vec3d semi_axes{0.05, 0.035, 0.025};
 
   /// Throws std::invalid_argument unless all semi-axes are finite and > 0.
@@ -247,11 +261,13 @@ struct Ellipsoid {
       throw std::invalid_argument("Ellipsoid: semi-axes must be finite and > 0");
     }
   }
+  /// Signed distance of `p` to the surface [m]: negative inside.
   template <class D = void>
   double signed_distance(const Deferred<Vec3d, D>& p) const {
     const double d = (p - closest_point(p)).norm();
     return p.cwiseQuotient(semi_axes).squaredNorm() < 1.0 ? -d : d;
   }
+  /// The point of the surface closest to `p`.
   template <class D = void>
   Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     const Vec3d& e = semi_axes;
@@ -289,6 +305,7 @@ struct Ellipsoid {
     for (int i = 0; i < 3; ++i) x[i] = std::copysign(x[i], p[i]);
     return x;
   }
+  /// Unit outward normal of the surface at the point closest to `p`.
   template <class D = void>
   Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = closest_point(p);
@@ -300,8 +317,8 @@ struct Ellipsoid {
 /// the tube's centre circle, tube radius `minor_radius` r < R [m]. Closed-form closest point: the
 /// nearest point of the centre circle, then r towards the query.
 struct Torus {
-  double major_radius = 0.04;
-  double minor_radius = 0.015;
+  double major_radius = 0.04;   ///< From the centre to the middle of the tube [m].
+  double minor_radius = 0.015;  ///< Radius of the tube [m].
 
   /// Throws std::invalid_argument unless 0 < minor_radius < major_radius, both finite.
   explicit Torus(double R = 0.04, double r = 0.015) : major_radius(R), minor_radius(r) {
@@ -310,14 +327,17 @@ struct Torus {
           "Torus: radii must be finite with 0 < minor_radius < major_radius");
     }
   }
+  /// Signed distance of `p` to the surface [m]: negative inside.
   template <class D = void>
   double signed_distance(const Deferred<Vec3d, D>& p) const {
     return (p - centre(p)).norm() - minor_radius;
   }
+  /// The point of the surface closest to `p`.
   template <class D = void>
   Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     return centre(p) + minor_radius * normal(p);
   }
+  /// Unit outward normal of the surface at the point closest to `p`.
   template <class D = void>
   Vec3d normal(const Deferred<Vec3d, D>& p) const {
     const Vec3d c = centre(p);
@@ -347,6 +367,7 @@ struct Torus {
 /// closed meshes.
 class TriangleMesh {
  public:
+  /// Three vertex indices, counter-clockwise seen from outside.
   using Triangle = std::array<std::uint32_t, 3>;
 
   /// Throws std::invalid_argument for no triangles, an index out of range, a non-finite vertex
@@ -412,7 +433,9 @@ class TriangleMesh {
     build_hierarchy();
   }
 
+  /// The vertices [m].
   [[nodiscard]] const std::vector<Vec3d>& vertices() const noexcept { return v_; }
+  /// The triangles.
   [[nodiscard]] const std::vector<Triangle>& triangles() const noexcept { return t_; }
   /// Area of triangle f [m^2].
   [[nodiscard]] double area(std::size_t f) const { return area_.at(f); }
@@ -430,12 +453,14 @@ class TriangleMesh {
   /// Nodes in the bounding-volume hierarchy.
   [[nodiscard]] std::size_t hierarchy_nodes() const noexcept { return nodes_.size(); }
 
+  /// Signed distance of `p` to the surface [m]: negative inside.
   template <class D = void>
   double signed_distance(const Deferred<Vec3d, D>& p) const {
     const Hit h = nearest(p);
     const double d = std::sqrt(h.d2);
     return (p - h.point).dot(h.pseudo_normal) < 0.0 ? -d : d;
   }
+  /// The point of the surface closest to `p`.
   template <class D = void>
   Vec3d closest_point(const Deferred<Vec3d, D>& p) const {
     return nearest(p).point;
