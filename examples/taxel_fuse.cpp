@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // taxel-fuse: a contact stream (CSV) in, the fused cloud (PLY) out, with the fusion policy and
 // the spatial index chosen by option.
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -67,6 +67,10 @@ options:
                     noise tail cannot start a point off the surface (default 6; 0: off)
   --gate CHI2       surfel, kalman: Mahalanobis gate (e.g. 11.345 for 99 %; default none)
   --process-noise Q surfel, kalman: process noise [m] per update (default 0)
+  --lateral-scatter surfel: the contacts' covariance across the normal is real scatter of
+                    their positions along the tangent plane (streams from kinematics or
+                    cameras), which lifts them off a curved surface; remove that lift
+                    (default: a footprint, as taxel's readings-to-contacts model states it)
   --min-observations N   keep only points with at least N contacts (default 1: all)
   --max-sigma S     keep only points whose largest standard deviation is at most S [m]
   --max-normal-sigma S  keep only points whose smallest standard deviation (across the
@@ -112,6 +116,7 @@ struct Options {
   double process_noise = 0.0;
   bool ascii = false;
   bool strict = false;
+  bool lateral_scatter = false;
   std::uint32_t min_observations = 1;
   std::string readings, poses, session;
   bool per_pad = false;
@@ -198,14 +203,14 @@ int fuse(const Options& o, typename Cloud::Config cfg, const Feed& feed,
   if (contacts > 0 && total_rejected == contacts) {
     // Nothing to write is a failed run, not an empty success (a --scale or --radius far off
     // makes every contact out of range).
-    const bool range = rejected.count(std::string(taxel::to_string(
-                           taxel::ContactDefect::out_of_range))) > 0;
-    args.fail("every one of the " + std::to_string(contacts) + " contacts was rejected (" +
-                  rejected.begin()->first + (rejected.size() > 1 ? ", ..." : "") + ")" +
-                  (range ? "; the index's range shrinks with --radius: check --radius and --scale"
-                         : "") +
-                  "; no cloud written",
-              1);
+    const bool range =
+        rejected.count(std::string(taxel::to_string(taxel::ContactDefect::out_of_range))) > 0;
+    args.fail(
+        "every one of the " + std::to_string(contacts) + " contacts was rejected (" +
+            rejected.begin()->first + (rejected.size() > 1 ? ", ..." : "") + ")" +
+            (range ? "; the index's range shrinks with --radius: check --radius and --scale" : "") +
+            "; no cloud written",
+        1);
   }
   if (o.policy != "raw" && fused == 0 && added >= 100) {  // raw never fuses
     std::fprintf(stderr,
@@ -340,6 +345,8 @@ int main(int argc, char** argv) {
       o.max_normal_sigma = args.length(0.0, kInf);
     } else if (a == "--strict") {
       o.strict = true;
+    } else if (a == "--lateral-scatter") {
+      o.lateral_scatter = true;
     } else if (a == "--ascii") {
       o.ascii = true;
     } else if (a == "--scale") {
@@ -389,6 +396,8 @@ int main(int argc, char** argv) {
         "--scale applies to CONTACTS.csv; the readings' geometry is set in metres by "
         "--pitch and --full-scale-depth");
   }
+  if (o.lateral_scatter && o.policy != "surfel")
+    args.fail("--lateral-scatter goes with --policy surfel");
   if (!from_readings && !from_session && !o.poses.empty()) {
     args.fail("--poses goes with --readings or --session");
   }
@@ -487,7 +496,8 @@ int main(int argc, char** argv) {
     } else if (o.policy == "kalman") {
       code = with_index<tf::Kalman<double>>(o, kc, feed, args);
     } else {
-      code = with_index<tf::Surfel<double>>(o, {.kalman = kc}, feed, args);
+      code = with_index<tf::Surfel<double>>(o, {.kalman = kc, .lateral_scatter = o.lateral_scatter},
+                                            feed, args);
     }
     return code == 0 && !shortfall.empty() ? 1 : code;
   } catch (const std::invalid_argument& e) {  // a configuration the cloud refuses

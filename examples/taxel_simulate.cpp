@@ -50,6 +50,8 @@ options:
   --exploration sliding|grasp|palpation   (default sliding)
   --contacts N       stop after N contacts, exploring further as needed (default 20000;
                      0: exactly the exploration below)
+  --footprint N      where a tactel senses: 1 at its centre (default); 2-4 the mean indentation
+                     over its area (N x N points), as a real tactel averages
   --per-pad          one contact per pad and frame (a quadric fitted to its depth map; one per
                      tactel when under six are active or the quadric does not fit them), not
                      one per tactel
@@ -258,6 +260,8 @@ int main(int argc, char** argv) {
       o.contacts = args.number<std::size_t>(0, std::size_t{1} << 26);
     } else if (a == "--per-pad") {
       o.config.contacts.mode = ts::ContactMode::per_pad;
+    } else if (a == "--footprint") {
+      o.config.footprint = args.number<int>(1, 4);
     } else if (a == "--slides") {
       o.slide.slides = args.number<int>(1, 10000);
     } else if (a == "--frames") {

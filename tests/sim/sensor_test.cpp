@@ -4,9 +4,11 @@
 // they came from, the stated covariance against the measured scatter, determinism, and bad
 // parameters.
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <taxel/sim.hpp>
 
@@ -281,4 +283,135 @@ TEST_CASE("explorations and sensor model refuse bad parameters", "[sim][explorat
   cfg = {};
   cfg.frame_rate = 0;
   CHECK_THROWS_WITH(ts::explore_grasps(s, cfg), Catch::Contains("frame_rate"));
+}
+
+TEST_CASE("footprint integration: a tactel reads its mean indentation over its square",
+          "[sim][sensor]") {
+  // A 5x5 pad of 3.4 mm tactels pressed 1 mm into the top of a 15 mm sphere, fine levels and no
+  // noise, so that a reading is the indentation to 46 nm.
+  const double R = 0.015, depth = 1e-3, a = 3.4e-3;
+  const ts::Sphere sphere{R};
+  ts::SensorModel m = noiseless();
+  m.geometry.rows = m.geometry.cols = 5;
+  m.geometry.pitch = a;
+  m.levels = 65536;
+  m.threshold = 1;
+  const double quantum = m.depth_per_count();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(M_PI, Vec3d::UnitX()).matrix();  // pad z -> world -z
+  T.translation() = Vec3d(0, 0, R - depth);
+  // The oracle: the compression sqrt(R^2 - x^2 - y^2) - (R - depth) averaged over the tactel's
+  // square by brute force (a 400 x 400 midpoint grid).
+  // Also says whether the whole square touches.
+  const auto mean_indentation = [&](double x0, double y0, bool& whole) {
+    const int n = 400;
+    double sum = 0.0;
+    whole = true;
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const double x = x0 + a * ((i + 0.5) / n - 0.5), y = y0 + a * ((j + 0.5) / n - 0.5);
+        const double d = std::sqrt(R * R - x * x - y * y) - (R - depth);
+        whole = whole && d > 0;
+        sum += std::max(0.0, d);
+      }
+    }
+    return sum / (n * n);
+  };
+  std::mt19937_64 rng(3);
+  const ts::PadReading centre = ts::read_pad(sphere, m, T, rng, 0, 1);
+  const ts::PadReading area2 = ts::read_pad(sphere, m, T, rng, 0, 2);
+  const ts::PadReading area4 = ts::read_pad(sphere, m, T, rng, 0, 4);
+  // The middle tactel, fully touching: it reads pitch^2 / (12 R) less than at its centre
+  // (64 um here; the closed form of a paraboloid, within its quartic term, 0.2 um).
+  const double at_centre = centre.counts(2, 2) * quantum, over_area = area4.counts(2, 2) * quantum;
+  CHECK(at_centre == Approx(depth).margin(quantum));
+  CHECK(at_centre - over_area == Approx(a * a / (12 * R)).margin(0.3e-6));
+  // Every tactel against the oracle. Where the whole square touches, the four-point rule is
+  // exact to the quantum and the two-point one within 1 um; where only part of it touches (the
+  // diagonal tactels here), the indentation has a kink and both are within 4 um.
+  int whole_squares = 0;
+  for (int r = 1; r <= 3; ++r) {
+    for (int c = 1; c <= 3; ++c) {
+      const Vec3d p = T * m.geometry.tactel(r, c);
+      bool whole = false;
+      const double want = mean_indentation(p.x(), p.y(), whole);
+      whole_squares += whole ? 1 : 0;
+      CAPTURE(r, c, want, whole);
+      CHECK(area4.counts(r, c) * quantum == Approx(want).margin(whole ? 2 * quantum : 4e-6));
+      CHECK(area2.counts(r, c) * quantum == Approx(want).margin(whole ? 1e-6 : 4e-6));
+    }
+  }
+  CHECK(whole_squares == 5);  // the middle and its four neighbours
+  // A tactel whose centre is off the object but part of its square is on it reads that part.
+  const double R2 = 0.0035;  // a 3.5 mm sphere under the 5x5 pad: the ring of tactels at 3.4 mm
+  const ts::Sphere small{R2};
+  Eigen::Isometry3d T2 = T;
+  T2.translation() = Vec3d(0, 0, R2 - depth);
+  const ts::PadReading edge1 = ts::read_pad(small, m, T2, rng, 0, 1);
+  const ts::PadReading edge4 = ts::read_pad(small, m, T2, rng, 0, 4);
+  CHECK(edge1.counts(2, 3) == 0);  // its centre is outside the sphere
+  CHECK(edge4.counts(2, 3) > 0);
+  CHECK_THROWS_AS(ts::read_pad(sphere, m, T, rng, 0, 5), std::invalid_argument);
+  CHECK_THROWS_AS(ts::read_pad(sphere, m, T, rng, 0, 0), std::invalid_argument);
+}
+
+TEST_CASE(
+    "contact_stream: stated covariances that match the scatter, unstated normal and pose "
+    "noise",
+    "[sim][stream]") {
+  const ts::Box box(Vec3d(0.06, 0.05, 0.04));
+  ts::ContactStreamConfig cfg;
+  cfg.contacts = 20000;
+  cfg.seed = 5;
+  cfg.normal_noise = 0.0;
+  cfg.pose_position = 0.0;
+  cfg.pose_angle = 0.0;
+  const auto a = ts::contact_stream(box, cfg);
+  REQUIRE(a.size() == 20000);
+  CHECK(ts::contact_stream(box, cfg)[12345].position == a[12345].position);  // deterministic
+  // Along the normal the scatter is the stated 0.3 mm, centred on the surface (flat faces; the
+  // contacts within 2 mm of an edge are left out).
+  double sum = 0, sum2 = 0;
+  std::size_t n = 0, exact_normals = 0;
+  for (const auto& c : a) {
+    REQUIRE(c.normal);
+    CHECK(c.normal_sigma == 0.0);  // not stated
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(c.covariance);
+    CHECK(es.eigenvalues()(0) == Approx(cfg.sigma_normal * cfg.sigma_normal).epsilon(1e-9));
+    CHECK(es.eigenvalues()(2) == Approx(cfg.sigma_lateral * cfg.sigma_lateral).epsilon(1e-9));
+    const Vec3d d = box.half_extents - c.position.cwiseAbs();
+    int near_edge = 0;
+    for (int k = 0; k < 3; ++k) near_edge += d[k] < 2e-3 ? 1 : 0;
+    if (near_edge != 1) continue;
+    const double s = box.signed_distance(c.position);
+    sum += s;
+    sum2 += s * s;
+    ++n;
+    exact_normals += (c.normal->cwiseAbs().maxCoeff() == 1.0) ? 1 : 0;
+  }
+  REQUIRE(n > 10000);
+  const double mean = sum / double(n), sd = std::sqrt(sum2 / double(n) - mean * mean);
+  CHECK(std::abs(mean) < 3 * cfg.sigma_normal / std::sqrt(double(n)));
+  CHECK(sd == Approx(cfg.sigma_normal).epsilon(0.03));
+  CHECK(exact_normals == n);  // without normal noise, a face's normal exactly
+  // Normal noise and a pose error, neither stated: the normals turn by about
+  // sqrt(2 normal_noise^2 + 2/3 pose_angle^2) on average (0.073 rad here).
+  cfg.normal_noise = 0.05;
+  cfg.pose_angle = 0.02;
+  cfg.pose_position = 0.2e-3;
+  const auto b = ts::contact_stream(box, cfg);
+  double angle = 0;
+  std::size_t m = 0;
+  for (const auto& c : b) {
+    const Vec3d d = box.half_extents - c.position.cwiseAbs();
+    if ((d.array() < 3e-3).count() != 1) continue;
+    angle += std::acos(std::clamp(c.normal->dot(box.normal(c.position)), -1.0, 1.0));
+    ++m;
+    CHECK(c.normal_sigma == 0.0);
+  }
+  const double expected = std::sqrt(std::numbers::pi / 2) *
+                          std::sqrt(2 * 0.05 * 0.05 + 2.0 / 3.0 * 0.02 * 0.02) / std::sqrt(2.0);
+  CHECK(angle / double(m) == Approx(expected).epsilon(0.1));
+  cfg.sigma_lateral = 0;
+  CHECK_THROWS_WITH(ts::contact_stream(box, cfg), Catch::Contains("sigma_lateral"));
 }

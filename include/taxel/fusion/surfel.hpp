@@ -69,6 +69,14 @@ struct Surfel {
     S normal_sigma = S(0.05);  ///< noise of a contact normal [rad], in [1e-6, pi]
     /// Prior standard deviation of the curvature [1/m], in [1e-6, 1e9].
     S curvature_prior = S(100);
+    /// What a contact's covariance across its normal says. false: where on the surface the
+    /// contact stands for, around a position that lies on the surface (a tactel's footprint in
+    /// taxel's readings-to-contacts model). true: how far the reported position scattered
+    /// along the surface's tangent plane from the true contact point, as in streams from a
+    /// kinematic model or a camera. Such scatter lifts a contact off a curved surface by
+    /// u'Hu / 2, tr(H Sigma_t) / 2 on average (sigma_t^2 / R on a sphere), which the point then
+    /// removes.
+    bool lateral_scatter = false;
   };
   /// A fused point: the filter in information form, its tangent frame and the curvature sums.
   /// Every member starts at zero (Eigen's vectors would otherwise start uninitialised, even in
@@ -97,6 +105,9 @@ struct Surfel {
     S ss[2] = {};      ///< v-weighted sum of s [-]
     S vuu[3] = {};     ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
     S ssu[4] = {};     ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
+    /// w-weighted sums of the stated covariance across the normal in the frame (xx, xy, yy)
+    /// [m^2] (Config::lateral_scatter only).
+    S scov[3] = {};
   };
   static constexpr bool kMerges =
       true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
@@ -187,6 +198,7 @@ struct Surfel {
     s.unit_normal = s.normal_sum * (S(1) / std::sqrt(s.normal_sum.squaredNorm()));
     s.count += S(1);
     add_sums(s, w, share(c), ux, uy, s.n0.dot(d), sx, sy);
+    add_scatter(s, w, c);
     return true;
   }
 
@@ -207,6 +219,10 @@ struct Surfel {
     // slope over one standard deviation of the offsets stays below 45 degrees); beyond that the
     // fit is noise, not a surface.
     S sag = S(0.5) * (h[0] * cxx + S(2) * h[1] * cxy + h[2] * cyy);
+    if (config_.lateral_scatter) {
+      // Less the lift of the tangent-plane scatter, tr(H Sigma_t) / 2 (Config::lateral_scatter).
+      sag -= S(0.5) * inv * (h[0] * s.scov[0] + S(2) * h[1] * s.scov[1] + h[2] * s.scov[2]);
+    }
     const S bound2 = S(0.25) * std::max(cxx + cyy, S(0));
     if (!(sag * sag <= bound2)) sag = std::copysign(std::sqrt(bound2), sag);  // rare: no sqrt
     const S z = s.sz * inv + sag;
@@ -281,8 +297,17 @@ struct Surfel {
     s.unit_normal = s.n0;
     s.count = S(1);
     const Vec3<S> d = c.position - s.origin;
-    add_sums(s, S(1) / s.n0.dot(c.covariance * s.n0), share(c), s.t1.dot(d), s.t2.dot(d),
-             s.n0.dot(d), S(0), S(0));
+    const S w = S(1) / s.n0.dot(c.covariance * s.n0);
+    add_sums(s, w, share(c), s.t1.dot(d), s.t2.dot(d), s.n0.dot(d), S(0), S(0));
+    add_scatter(s, w, c);
+  }
+  // The stated covariance across the normal, in the frame (Config::lateral_scatter).
+  void add_scatter(State& s, S w, const Contact<S>& c) const {
+    if (!config_.lateral_scatter) return;
+    const Vec3<S> c1 = c.covariance * s.t1, c2 = c.covariance * s.t2;
+    s.scov[0] += w * s.t1.dot(c1);
+    s.scov[1] += w * s.t1.dot(c2);
+    s.scov[2] += w * s.t2.dot(c2);
   }
   // The filter's update with the information ri = R^-1 (upper triangle) of a contact at
   // offset d = m - origin: a Kalman filter with identity models in information form,

@@ -31,6 +31,9 @@ struct ExplorationConfig {
   sensor::ContactOptions contacts{};  ///< how readings become contacts (per tactel or per pad)
   double frame_rate = 1000.0;         ///< frames per second [Hz], in (0, 1e6]
   double indentation = 1.0e-3;        ///< how far a pad presses into the object [m], in (0, 1]
+  /// Where a simulated tactel senses (read_pad): 1 at its centre, n in [2, 4] the mean
+  /// indentation over its area (n x n Gauss-Legendre points), as a real tactel does.
+  int footprint = 1;
   Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  ///< shape frame -> world
   std::uint64_t seed = 1;                                         ///< equal seeds, equal output
 
@@ -46,6 +49,8 @@ struct ExplorationConfig {
           "ExplorationConfig: indentation must be in (0, 1] m (a length in millimetres given as "
           "metres?)");
     }
+    if (footprint < 1 || footprint > 4)
+      throw std::invalid_argument("ExplorationConfig: footprint must be in [1, 4]");
     if (!object_pose.matrix().allFinite())
       throw std::invalid_argument("ExplorationConfig: object_pose must be finite");
   }
@@ -201,7 +206,7 @@ Exploration<Sh> explore_sliding(const Sh& shape, const ExplorationConfig& cfg,
     for (std::size_t f = 0; f < p.frames; ++f, ++tick) {
       const Eigen::Isometry3d pose = detail::pad_pose(-n, heading, at - cfg.indentation * n);
       std::vector<PadReading> pads;
-      pads.push_back(read_pad(world, cfg.sensor, pose, rng, 0));
+      pads.push_back(read_pad(world, cfg.sensor, pose, rng, 0, cfg.footprint));
       detail::add_frame(ex, extractor, double(tick) / cfg.frame_rate, std::move(pads));
       heading = Eigen::AngleAxisd(p.heading_sigma * gauss(rng), n) * heading;
       at = world.closest_point(at + step * heading);
@@ -296,7 +301,8 @@ Exploration<Sh> explore_grasps(const Sh& shape, const ExplorationConfig& cfg,
         const double s = pad.touch >= 0.0 ? pad.touch + s_rel : 0.0;  // a miss stays open
         const Eigen::Isometry3d pose =
             detail::pad_pose(pad.inward, axis, pad.origin + s * pad.inward);
-        readings.push_back(read_pad(world, cfg.sensor, pose, rng, static_cast<int>(i)));
+        readings.push_back(
+            read_pad(world, cfg.sensor, pose, rng, static_cast<int>(i), cfg.footprint));
       }
       detail::add_frame(ex, extractor, double(tick) / cfg.frame_rate, std::move(readings));
     }
@@ -331,7 +337,8 @@ Exploration<Sh> explore_palpation(const Sh& shape, const ExplorationConfig& cfg,
     for (int f = 0; f < pressing + p.hold_frames; ++f, ++tick) {
       const double s = std::min(double(f - 2) * step, cfg.indentation);
       std::vector<PadReading> readings;
-      readings.push_back(read_pad(world, cfg.sensor, detail::pad_pose(-n, y, at - s * n), rng, 0));
+      readings.push_back(
+          read_pad(world, cfg.sensor, detail::pad_pose(-n, y, at - s * n), rng, 0, cfg.footprint));
       detail::add_frame(ex, extractor, double(tick) / cfg.frame_rate, std::move(readings));
     }
   }

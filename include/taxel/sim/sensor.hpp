@@ -89,13 +89,35 @@ double compression(const Sh& shape, const Vec3d& at, const Vec3d& back) {
 
 /// Reads a pad pressed against `shape` (in world coordinates; wrap a placed shape in `Posed`)
 /// at `true_pose`, drawing the frame's kinematic noise and the tactels' depth noise from `rng`.
-/// A tactel inside the shape is compressed by the distance along the pad normal back to the
-/// surface (`compression`); its contact, pushed back that far, lies on the surface.
-/// Throws std::invalid_argument for an invalid model.
+/// A point of the pad inside the shape is compressed by the distance along the pad normal back
+/// to the surface (`compression`).
+///
+/// `footprint` says where a tactel senses. 1: at its centre only, so that its contact, pushed
+/// back by the reading, lies on the surface. n >= 2: the mean compression over the tactel's
+/// pitch x pitch square (n x n Gauss-Legendre points, n <= 4; 2 is exact for a paraboloid), as
+/// a real tactel averages over its area. On a convex surface of radius R a fully touching
+/// tactel then reads pitch^2 / (12 R) less than at its centre, and a tactel partly off the
+/// object reads its touching share. Throws std::invalid_argument for an invalid model or a
+/// footprint outside [1, 4].
 template <Shape Sh, class Rng>
 PadReading read_pad(const Sh& shape, const SensorModel& model, const Eigen::Isometry3d& true_pose,
-                    Rng& rng, int pad = 0) {
+                    Rng& rng, int pad = 0, int footprint = 1) {
   model.validate();
+  if (footprint < 1 || footprint > 4) {
+    throw std::invalid_argument("read_pad: footprint must be in [1, 4] samples per side");
+  }
+  // Gauss-Legendre nodes on [-1/2, 1/2] and their weights (summing to 1), per footprint.
+  static constexpr double kNode[4][4] = {
+      {0.0},
+      {-0.28867513459481287, 0.28867513459481287},
+      {-0.3872983346207417, 0.0, 0.3872983346207417},
+      {-0.43056815579702629, -0.16999052179242813, 0.16999052179242813, 0.43056815579702629}};
+  static constexpr double kWeight[4][4] = {
+      {1.0},
+      {0.5, 0.5},
+      {0.2777777777777778, 0.4444444444444444, 0.2777777777777778},
+      {0.17392742256872692, 0.32607257743127307, 0.32607257743127307, 0.17392742256872692}};
+  const int k = footprint - 1;
   std::normal_distribution<double> gauss(0.0, 1.0);
   const PadGeometry& g = model.geometry;
   PadReading out;
@@ -106,9 +128,24 @@ PadReading read_pad(const Sh& shape, const SensorModel& model, const Eigen::Isom
   const Vec3d back = -true_pose.linear().col(2);
   for (int r = 0; r < g.rows; ++r) {
     for (int c = 0; c < g.cols; ++c) {
-      const Vec3d at = true_pose * g.tactel(r, c);
-      if (!(shape.signed_distance(at) < 0.0)) continue;
-      const double depth = compression(shape, at, back);
+      double depth = 0.0;
+      if (footprint == 1) {
+        const Vec3d at = true_pose * g.tactel(r, c);
+        if (!(shape.signed_distance(at) < 0.0)) continue;
+        depth = compression(shape, at, back);
+      } else {
+        bool touching = false;
+        for (int i = 0; i < footprint; ++i) {
+          for (int j = 0; j < footprint; ++j) {
+            const Vec3d at =
+                true_pose * (g.tactel(r, c) + g.pitch * Vec3d(kNode[k][j], kNode[k][i], 0.0));
+            if (!(shape.signed_distance(at) < 0.0)) continue;
+            touching = true;
+            depth += kWeight[k][i] * kWeight[k][j] * compression(shape, at, back);
+          }
+        }
+        if (!touching) continue;
+      }
       const double measured = depth + model.sigma_normal * gauss(rng);
       const double counts = std::min(std::round(measured * scale), double(model.levels - 1));
       if (counts >= model.threshold) out.counts(r, c) = static_cast<std::uint16_t>(counts);
