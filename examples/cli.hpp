@@ -139,8 +139,7 @@ inline bool parse_length(std::string_view text, double& metres) {
 /// is the standard stream `std_fd` (0 for an input, 1 for an output); a path is followed
 /// through symbolic links, so /dev/stdin, /dev/fd/0 and /proc/self/fd/0 are the file the
 /// shell redirected. Nothing for a missing file, a pipe, a terminal or a device.
-inline std::optional<std::pair<dev_t, ino_t>> regular_file_id(std::string_view path,
-                                                              int std_fd) {
+inline std::optional<std::pair<dev_t, ino_t>> regular_file_id(std::string_view path, int std_fd) {
   struct ::stat st {};
   const int rc = path == "-" ? ::fstat(std_fd, &st) : ::stat(std::string(path).c_str(), &st);
   if (rc != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
@@ -166,9 +165,10 @@ inline bool same_file(std::string_view a, std::string_view b, int a_fd = 0, int 
   return !ec && ca == cb;
 }
 
-/// Why the output `output` cannot be written, or "" when it can: it is one of `inputs` or of `other_outputs` (same_file; "-" is standard input among the inputs
-/// and standard output among the outputs). A tool writes its outputs after reading its inputs,
-/// so it would replace an input with its result, or one output with another.
+/// Why the output `output` cannot be written, or "" when it can: it is one of `inputs` or of
+/// `other_outputs` (same_file; "-" is standard input among the inputs and standard output among the
+/// outputs). A tool writes its outputs after reading its inputs, so it would replace an input with
+/// its result, or one output with another.
 template <class Inputs = std::initializer_list<std::string_view>>
 std::string output_conflict(std::string_view output, const Inputs& inputs,
                             std::initializer_list<std::string_view> other_outputs = {}) {

@@ -10,14 +10,14 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstddef>
-#include <cstring>
 #include <cstdint>
+#include <cstring>
 #include <initializer_list>
 #include <limits>
 #include <map>
 #include <mutex>
-#include <shared_mutex>
 #include <optional>
+#include <shared_mutex>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -88,8 +88,8 @@ StrictArray<T> strict_array(py::handle src) {
       const std::string range = std::to_string(std::numeric_limits<T>::min()) + ", " +
                                 std::to_string(std::numeric_limits<T>::max());
       const auto refuse = [&](py::ssize_t k, const std::string& value) {
-        throw py::value_error("expected whole numbers in [" + range + "], got " + value +
-                              " at " + index_text(a, k));
+        throw py::value_error("expected whole numbers in [" + range + "], got " + value + " at " +
+                              index_text(a, k));
       };
       if (kind == 'f') {
         const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
@@ -301,9 +301,7 @@ struct type_caster<taxel::python::StrictArray<T>,
     value = taxel::python::detail::strict_array<T>(src);
     return true;
   }
-  static handle cast(const Array& src, return_value_policy, handle) {
-    return src.inc_ref();
-  }
+  static handle cast(const Array& src, return_value_policy, handle) { return src.inc_ref(); }
 };
 }  // namespace pybind11::detail
 

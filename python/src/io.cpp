@@ -19,9 +19,7 @@ py::array_t<std::uint32_t> triangles_array(const Triangles& t) {
   return out;
 }
 
-Triangles triangles_from(
-    const ArrayI64& a,
-    std::size_t vertices) {
+Triangles triangles_from(const ArrayI64& a, std::size_t vertices) {
   require_shape(a, {-1, 3}, "triangles", "(T, 3)");
   Triangles t(static_cast<std::size_t>(a.shape(0)));
   for (py::ssize_t i = 0; i < a.size(); ++i) {
@@ -61,9 +59,7 @@ write leaves no partial file.)doc");
       py::arg("path"), "(PointCloud, triangles (T, 3) uint32) of an ASCII or binary PLY file.");
   m.def(
       "write_ply",
-      [](const std::string& path, const Cloud& cloud,
-         const std::optional<ArrayI64>&
-             triangles,
+      [](const std::string& path, const Cloud& cloud, const std::optional<ArrayI64>& triangles,
          bool binary) {
         const Triangles t = triangles ? triangles_from(*triangles, cloud.size()) : Triangles{};
         io::write_ply(path, cloud,

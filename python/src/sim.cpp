@@ -183,9 +183,7 @@ palm-grasp pressure-image synthesiser.)doc");
                                     "A closed triangle mesh; closest points through a bounding-"
                                     "volume hierarchy.");
   mesh.def(
-      py::init([](const ArrayD& vertices,
-                  const ArrayI64&
-                      triangles) {
+      py::init([](const ArrayD& vertices, const ArrayI64& triangles) {
         std::vector<Vec3d> v = points_from(vertices, "vertices");
         require_shape(triangles, {-1, 3}, "triangles", "(T, 3)");
         std::vector<sm::TriangleMesh::Triangle> t(static_cast<std::size_t>(triangles.shape(0)));

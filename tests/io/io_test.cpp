@@ -12,8 +12,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <vector>
 #include <taxel/io.hpp>
+#include <vector>
 
 #if defined(TAXEL_TEST_HAVE_PNG)
 #include <zlib.h>
@@ -583,6 +583,26 @@ std::filesystem::path fresh_dir(const std::string& name) {
   std::filesystem::create_directories(dir);
   return dir;
 }
+// The message of the taxel::IoError that `write` throws while files may grow to 4 KiB at most
+// (the file size limit stands in for a full disk), or "" when it throws none.
+template <class Write>
+std::string io_error_under_size_limit(Write write) {
+  struct ::rlimit old {};
+  REQUIRE(::getrlimit(RLIMIT_FSIZE, &old) == 0);
+  const auto previous_handler = std::signal(SIGXFSZ, SIG_IGN);
+  struct ::rlimit small = old;
+  small.rlim_cur = 4096;
+  REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
+  std::string error;
+  try {
+    write();
+  } catch (const taxel::IoError& e) {
+    error = e.what();
+  }
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, previous_handler);
+  return error;
+}
 std::size_t entries(const std::filesystem::path& dir) {
   return static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(dir),
                                                 std::filesystem::directory_iterator()));
@@ -608,20 +628,8 @@ TEST_CASE("write_file: whole or not at all, the previous file kept on failure",
 
   // A write that fails half way (the file size limit stands in for a full disk): the error
   // names the file and the reason; the old content survives; nothing is left behind.
-  struct ::rlimit old {};
-  REQUIRE(::getrlimit(RLIMIT_FSIZE, &old) == 0);
-  const auto previous_handler = std::signal(SIGXFSZ, SIG_IGN);
-  struct ::rlimit small = old;
-  small.rlim_cur = 4096;
-  REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
-  std::string error;
-  try {
-    tio::write_file(path, std::string(100000, 'x'));
-  } catch (const taxel::IoError& e) {
-    error = e.what();
-  }
-  ::setrlimit(RLIMIT_FSIZE, &old);
-  std::signal(SIGXFSZ, previous_handler);
+  const std::string error =
+      io_error_under_size_limit([&] { tio::write_file(path, std::string(100000, 'x')); });
   CHECK_THAT(error, Contains("out.txt") && Contains("File too large"));
   CHECK(tio::read_file(path) == "third");
   CHECK(entries(dir) == 1);
@@ -689,20 +697,9 @@ TEST_CASE("write_files: a set is written whole, or none of its files is replaced
                     Contains("missing") && Contains("No such file"));
   CHECK(tio::read_file(a) == "readings 1");
   // A file that fills the disk part-way (the size limit stands in for it): neither replaced.
-  struct ::rlimit old {};
-  REQUIRE(::getrlimit(RLIMIT_FSIZE, &old) == 0);
-  const auto previous_handler = std::signal(SIGXFSZ, SIG_IGN);
-  struct ::rlimit small = old;
-  small.rlim_cur = 4096;
-  REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
-  std::string error;
-  try {
+  const std::string error = io_error_under_size_limit([&] {
     tio::write_files({{a, "readings 3"}, {b, std::string(100000, 'x')}});
-  } catch (const taxel::IoError& e) {
-    error = e.what();
-  }
-  ::setrlimit(RLIMIT_FSIZE, &old);
-  std::signal(SIGXFSZ, previous_handler);
+  });
   CHECK_THAT(error, Contains("poses.csv") && Contains("File too large"));
   CHECK(tio::read_file(a) == "readings 1");
   CHECK(tio::read_file(b) == "poses 1");
@@ -711,7 +708,9 @@ TEST_CASE("write_files: a set is written whole, or none of its files is replaced
 
 TEST_CASE("LineReader and FileLineReader: LF, CRLF, a lone CR, and a byte-order mark",
           "[io][reliability]") {
-  const std::string text = "\xEF\xBB\xBF" "a,b\r\nc\rd\n\ne\r";
+  const std::string text =
+      "\xEF\xBB\xBF"
+      "a,b\r\nc\rd\n\ne\r";
   const std::vector<std::string> want{"a,b", "c", "d", "", "e"};
   std::vector<std::string> got;
   tio::LineReader lines(text);
@@ -740,7 +739,9 @@ TEST_CASE("LineReader and FileLineReader: LF, CRLF, a lone CR, and a byte-order 
 
 TEST_CASE("ContactsCsvReader streams what parse_contacts_csv reads, in batches",
           "[io][reliability]") {
-  std::string text = "\xEF\xBB\xBF" "time,x,y,z,pressure\r";
+  std::string text =
+      "\xEF\xBB\xBF"
+      "time,x,y,z,pressure\r";
   for (int i = 0; i < 1000; ++i) {
     text += std::to_string(i) + "," + std::to_string(i * 1e-3) + ",0,0,1\r";
   }
@@ -783,6 +784,7 @@ TEST_CASE("npy shapes follow Python's tuple grammar", "[io][reliability]") {
   CHECK(tio::parse_npy_u16(npy("<u2", "(1, 1,)", one)).shape == std::vector<std::size_t>{1, 1});
   for (const char* bad : {"(1,, 1)", "(,)", "(1, ,)", "(,1)"}) {
     CAPTURE(bad);
-    CHECK_THROWS_WITH(tio::parse_npy_u16(npy("<u2", bad, one)), Contains("is not a tuple of sizes"));
+    CHECK_THROWS_WITH(tio::parse_npy_u16(npy("<u2", bad, one)),
+                      Contains("is not a tuple of sizes"));
   }
 }

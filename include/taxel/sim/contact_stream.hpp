@@ -101,17 +101,18 @@ std::vector<Contact<double>> contact_stream(const Sh& shape, const ContactStream
       const Vec3d vc = nc.cross(uc);
       if (!uc.allFinite()) break;
       Eigen::Matrix3d pose_rotation =
-          Eigen::AngleAxisd(cfg.pose_angle * gauss(rng), Vec3d(gauss(rng), gauss(rng), gauss(rng))
-                                                             .normalized())
+          Eigen::AngleAxisd(cfg.pose_angle * gauss(rng),
+                            Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized())
               .toRotationMatrix();
       if (!pose_rotation.allFinite()) pose_rotation.setIdentity();
       const Vec3d pose_shift(cfg.pose_position * gauss(rng), cfg.pose_position * gauss(rng),
                              cfg.pose_position * gauss(rng));
       for (int r = 0; r < cfg.rows; ++r) {
         for (int c = 0; c < cfg.cols; ++c) {
-          const Vec3d site = centre + cfg.pitch * ((c - 0.5 * (cfg.cols - 1)) * vc +
-                                                   (r - 0.5 * (cfg.rows - 1)) * uc) -
-                             cfg.indentation * nc;
+          const Vec3d site =
+              centre +
+              cfg.pitch * ((c - 0.5 * (cfg.cols - 1)) * vc + (r - 0.5 * (cfg.rows - 1)) * uc) -
+              cfg.indentation * nc;
           if (!(shape.signed_distance(site) < 0.0)) continue;  // this site does not touch
           const Vec3d q = shape.closest_point(site);
           const Vec3d nq = shape.normal(q);

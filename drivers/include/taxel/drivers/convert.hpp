@@ -8,8 +8,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <span>
@@ -140,9 +140,9 @@ class SessionPoses {
     for (const io::PadPose& p : io::parse_pad_poses_csv(text, source)) {
       if (p.pad >= matrices) {
         throw IoError(source, "matrix " + std::to_string(p.pad) + " at time_ms " +
-                                  std::to_string(std::llround(p.time * 1e3)) + ": the session has " +
-                                  std::to_string(matrices) + " matrices (0 to " +
-                                  std::to_string(matrices - 1) + ")");
+                                  std::to_string(std::llround(p.time * 1e3)) +
+                                  ": the session has " + std::to_string(matrices) +
+                                  " matrices (0 to " + std::to_string(matrices - 1) + ")");
       }
       auto& row = table_[static_cast<std::uint32_t>(std::llround(p.time * 1e3))];
       row.resize(matrices);
