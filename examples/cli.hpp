@@ -376,24 +376,6 @@ inline void write_outputs(const std::vector<std::pair<std::string, std::string>>
   }
 }
 
-/// `s` with control characters (a NUL, an escape, a line break) shown as \\xNN, so that text
-/// from a file cannot cut or garble a one-line message.
-inline std::string printable(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (const char c : s) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", u);
-      out += buf;
-    } else {
-      out.push_back(c);
-    }
-  }
-  return out;
-}
-
 /// `s` with quotes and backslashes escaped and control characters blanked, for JSON strings.
 inline std::string json_escape(std::string_view s) {
   std::string out;

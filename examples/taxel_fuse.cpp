@@ -464,7 +464,7 @@ int main(int argc, char** argv) {
       const std::size_t shown = std::min<std::size_t>(report.ignored_columns.size(), 5);
       for (std::size_t k = 0; k < shown; ++k) {
         std::fprintf(stderr, "taxel-fuse: %s: ignoring unknown column '%s'\n", name.c_str(),
-                     taxel_cli::printable(report.ignored_columns[k]).c_str());
+                     taxel::printable(report.ignored_columns[k]).c_str());
       }
       if (report.ignored_columns.size() > shown) {
         std::fprintf(stderr, "taxel-fuse: %s: ignoring %zu more unknown columns\n", name.c_str(),

@@ -6,9 +6,28 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace taxel {
+
+/// `text` with control characters (a NUL, a line break, an escape, DEL) shown as `\\xNN`, so
+/// that text quoted from an input cannot cut or split a one-line message.
+inline std::string printable(std::string_view text) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u != 0x7f) {
+      out.push_back(c);
+    } else {
+      out.append("\\x").push_back(kHex[u >> 4]);
+      out.push_back(kHex[u & 15]);
+    }
+  }
+  return out;
+}
 
 /// A file or stream could not be read or written, or its content is malformed.
 /// `what()` reads "<source>:<line>: <reason>" or "<source>: byte <offset>: <reason>", with
@@ -46,19 +65,7 @@ class IoError : public std::runtime_error {
     s.append(": ").append(reason);
     // Control bytes quoted from an input (a NUL, a line break, an escape) are shown as \xNN:
     // a NUL would cut the message where C strings end, a line break would split it.
-    std::string out;
-    out.reserve(s.size());
-    for (const char c : s) {
-      const auto u = static_cast<unsigned char>(c);
-      if (u >= 0x20 && u != 0x7f) {
-        out.push_back(c);
-      } else {
-        static constexpr char kHex[] = "0123456789abcdef";
-        out.append("\\x").push_back(kHex[u >> 4]);
-        out.push_back(kHex[u & 15]);
-      }
-    }
-    return out;
+    return printable(s);
   }
 
   std::string source_;
