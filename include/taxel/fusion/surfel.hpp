@@ -108,6 +108,16 @@ struct Surfel {
     /// w-weighted sums of the stated covariance across the normal in the frame (xx, xy, yy)
     /// [m^2] (Config::lateral_scatter only).
     S scov[3] = {};
+    /// Information J_x [1/m^2] and information vector eta_x [1/m] of the contacts apart from
+    /// the patch (without a normal, or turned further than max_normal_angle), which the filter
+    /// took unturned.
+    S xinfo[6] = {};
+    Vec3<S> xeta = Vec3<S>::Zero();  ///< see xinfo
+    S sss[3] = {};                   ///< v-weighted sums of s_x^2, s_x s_y, s_y^2 [-]
+    /// Information [1/m^2] and information vector [1/m] of every contact unturned: plain
+    /// Kalman's, the point's estimate where one smooth patch does not fit its contacts.
+    S kinfo[6] = {};
+    Vec3<S> keta = Vec3<S>::Zero();  ///< see kinfo
   };
   static constexpr bool kMerges =
       true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
@@ -148,7 +158,12 @@ struct Surfel {
     } else {
       inverse(c.covariance, s.info);
     }
-    if (c.normal) start_frame(s, c);
+    for (int i = 0; i < 6; ++i) s.kinfo[i] = s.info[i];
+    if (c.normal) {
+      start_frame(s, c);
+    } else {
+      for (int i = 0; i < 6; ++i) s.xinfo[i] = s.info[i];
+    }
     return s;
   }
 
@@ -157,7 +172,15 @@ struct Surfel {
     S ci[6];  // the contact's information R^-1: it does not depend on the state
     inverse(c.covariance, ci);
     const Vec3<S> d = c.position - s.origin;  // the offset from the point's origin
-    if (!c.normal) return filter(s, d, ci);
+    if (!fuse_turned(s, c, d, ci)) return false;
+    for (int i = 0; i < 6; ++i) s.kinfo[i] += ci[i];
+    s.keta += times(ci, d);
+    return true;
+  }
+
+ private:
+  bool fuse_turned(State& s, const Contact<S>& c, const Vec3<S>& d, const S ci[6]) const {
+    if (!c.normal) return filter_apart(s, d, ci);
     if (s.count == S(0)) {
       if (!filter(s, d, ci)) return false;
       start_frame(s, c);
@@ -166,7 +189,10 @@ struct Surfel {
     const Vec3<S>& nc = *c.normal;
     const Vec3<S>& nm = s.unit_normal;
     const S cos_c = nc.dot(nm);
-    if (!(cos_c >= cos_max_)) return filter(s, d, ci);
+    // A slope is tan of the normal's angle to n0: beyond max_normal_angle (from the mean normal
+    // or from n0) it is no curvature datum but another face across an edge, or an outlier.
+    const S nz = nc.dot(s.n0);
+    if (!(cos_c >= cos_max_) || !(nz >= cos_max_)) return filter_apart(s, d, ci);
     // Turn the information onto the mean normal: Q R^-1 Q' with Q = I + [v]x + [v]x^2 / (1 + c),
     // v = nc x nm, [v]x^2 = v v' - |v|^2 I written out; only the upper triangle is formed (it
     // is symmetric by construction).
@@ -185,10 +211,6 @@ struct Surfel {
     if (!filter(s, d, turned)) return false;
     // Curvature sums in the frame of the first contact.
     const S ux = s.t1.dot(d), uy = s.t2.dot(d);
-    // A slope is tan of the normal's angle to n0: beyond max_normal_angle it is no curvature
-    // datum but an edge or an outlier, and would dominate the fit.
-    const S nz = nc.dot(s.n0);
-    if (!(nz >= cos_max_)) return true;
     const S inv_nz = S(1) / nz;
     const S sx = s.t1.dot(nc) * inv_nz, sy = s.t2.dot(nc) * inv_nz;
     // Weighted like the filter along the normal, by the contact's information there: the
@@ -202,6 +224,7 @@ struct Surfel {
     return true;
   }
 
+ public:
   /// The surface point [m]: the point of the quadric fitted to the contacts above their
   /// weighted centroid in the tangent plane (`filter_mean` until a contact with a normal
   /// arrives).
@@ -226,8 +249,45 @@ struct Surfel {
     const S bound2 = S(0.25) * std::max(cxx + cyy, S(0));
     if (!(sag * sag <= bound2)) sag = std::copysign(std::sqrt(bound2), sag);  // rare: no sqrt
     const S z = s.sz * inv + sag;
-    return s.origin + ux * s.t1 + uy * s.t2 + z * s.n0;
+    Vec3<S> d = ux * s.t1 + uy * s.t2 + z * s.n0;
+    if (s.xinfo[0] > S(0)) {
+      // The patch's point as a measurement with the patch's information J - J_x, fused with
+      // the contacts apart from it: (J - J_x) d + eta_x, through J^-1.
+      S ja[6], p[6];
+      for (int i = 0; i < 6; ++i) ja[i] = s.info[i] - s.xinfo[i];
+      inverse(s.info, p);
+      d = times(p, times(ja, d) + s.xeta);
+    }
+    const S a = crease_share(s, h);
+    if (a > S(0)) {
+      S p[6];
+      inverse(s.kinfo, p);
+      d += a * (times(p, s.keta) - d);
+    }
+    return s.origin + d;
   }
+  /// How far the point behaves as plain Kalman, in [0, 1]: 0 while one smooth patch describes
+  /// its contacts' normals, 1 where the residual of the slope fit is beyond `crease_chi2` times
+  /// the normals' noise.
+  S crease_share(const State& s, const S h[3]) const noexcept {
+    if (s.count < S(6)) return S(0);
+    const S inv = S(1) / s.vweight;
+    const S ux = s.vu[0] * inv, uy = s.vu[1] * inv, sx = s.ss[0] * inv, sy = s.ss[1] * inv;
+    const S cuu[3] = {s.vuu[0] * inv - ux * ux, s.vuu[1] * inv - ux * uy, s.vuu[2] * inv - uy * uy};
+    const S css[3] = {s.sss[0] * inv - sx * sx, s.sss[1] * inv - sx * sy, s.sss[2] * inv - sy * sy};
+    const S csu[4] = {s.ssu[0] * inv - sx * ux, s.ssu[1] * inv - sx * uy,
+                      s.ssu[2] * inv - sy * ux, s.ssu[3] * inv - sy * uy};
+    // Residual of s - H u: tr(C_ss) - 2 tr(H C_us) + tr(H C_uu H), per slope.
+    const S hc = h[0] * csu[0] + h[1] * (csu[1] + csu[2]) + h[2] * csu[3];
+    const S hh0 = h[0] * h[0] + h[1] * h[1], hh1 = h[0] * h[1] + h[1] * h[2];
+    const S hh2 = h[1] * h[1] + h[2] * h[2];
+    const S hch = hh0 * cuu[0] + S(2) * hh1 * cuu[1] + hh2 * cuu[2];
+    const S r2 = S(0.5) * (css[0] + css[2] - S(2) * hc + hch);
+    const S expected = config_.normal_sigma * config_.normal_sigma * s.weight * inv;
+    const S t = r2 / expected;
+    return std::clamp((t - kCreaseLow) / (kCreaseHigh - kCreaseLow), S(0), S(1));
+  }
+  static constexpr S kCreaseLow = S(9), kCreaseHigh = S(25);
   /// The point's surface normal (unit): the normal of the fitted quadric at the point `mean`
   /// reports, from the contacts' slopes as the curvature fit weighs them, or zero when no
   /// contact had a normal. The slope there is s(c) = s_mean + H (c - u_mean) (c the weighted
@@ -335,10 +395,31 @@ struct Surfel {
       if (q2_ > S(0)) {
         inverse(p, s.info);
         s.eta = times(s.info, mu);
+        predict(s.kinfo, s.keta);
+        if (s.xinfo[0] > S(0)) predict(s.xinfo, s.xeta);
       }
     }
     for (int i = 0; i < 6; ++i) s.info[i] += ri[i];
     s.eta += times(ri, d);
+    return true;
+  }
+  // The process noise's prediction of an information pair: J <- (J^-1 + q^2 I)^-1, the mean
+  // J^-1 eta kept.
+  void predict(S info[6], Vec3<S>& eta) const {
+    S p[6];
+    inverse(info, p);
+    const Vec3<S> mu = times(p, eta);
+    p[0] += q2_;
+    p[3] += q2_;
+    p[5] += q2_;
+    inverse(p, info);
+    eta = times(info, mu);
+  }
+  // The filter's update with a contact apart from the patch, kept in J_x and eta_x as well.
+  bool filter_apart(State& s, const Vec3<S>& d, const S ri[6]) const {
+    if (!filter(s, d, ri)) return false;
+    for (int i = 0; i < 6; ++i) s.xinfo[i] += ri[i];
+    s.xeta += times(ri, d);
     return true;
   }
   // The inverse of a symmetric positive definite 3x3 matrix (upper triangle, row by row) by
@@ -396,6 +477,9 @@ struct Surfel {
     s.ssu[1] += v * sx * uy;
     s.ssu[2] += v * sy * ux;
     s.ssu[3] += v * sy * uy;
+    s.sss[0] += v * sx * sx;
+    s.sss[1] += v * sx * sy;
+    s.sss[2] += v * sy * sy;
   }
 
   Config config_{};
