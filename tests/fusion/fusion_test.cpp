@@ -1047,3 +1047,97 @@ TEST_CASE(
     CHECK(std::abs(distance(lifted.mean(sl))) < 0.35 * lift);
   }
 }
+
+namespace {
+// Contacts on the faces of a convex solid near a crease or a corner: each face f is the plane
+// n_f . x = 0 (outward unit normal n_f), and the solid is where every n_f . x <= 0. A contact
+// is a point of one face on the solid, moved by 0.3 mm along the face's normal and by `lateral`
+// across it, as its covariance states; its normal is the face's, turned by `noise` about each
+// axis (not stated). Kept when its reported position lies within `spread` of `at`, as a
+// cloud's gate keeps them.
+std::vector<taxel::Contact<double>> face_contacts(const std::vector<taxel::Vec3d>& faces,
+                                                  const taxel::Vec3d& at, double spread,
+                                                  double lateral, double noise, int count,
+                                                  std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const double reach = spread + 4 * lateral + 1.2e-3;
+  std::uniform_real_distribution<double> u(-reach, reach);
+  std::uniform_int_distribution<std::size_t> pick(0, faces.size() - 1);
+  std::vector<taxel::Contact<double>> out;
+  while (int(out.size()) < count) {
+    const taxel::Vec3d& n = faces[pick(rng)];
+    const taxel::Vec3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    const taxel::Vec3d q = at - n * n.dot(at) + u(rng) * t1 + u(rng) * t2;
+    bool on_solid = true;
+    for (const auto& m : faces) on_solid = on_solid && m.dot(q) <= 1e-15;
+    if (!on_solid) continue;
+    taxel::Contact<double> c;
+    c.position = q + 0.3e-3 * g(rng) * n + lateral * (g(rng) * t1 + g(rng) * t2);
+    c.covariance = taxel::pad_covariance<double>(n, 0.3e-3, std::max(lateral, 0.3e-3));
+    const Eigen::Matrix3d turn(Eigen::AngleAxisd(noise * g(rng), taxel::Vec3d::UnitX()) *
+                               Eigen::AngleAxisd(noise * g(rng), taxel::Vec3d::UnitY()) *
+                               Eigen::AngleAxisd(noise * g(rng), taxel::Vec3d::UnitZ()));
+    c.normal = (turn * n).normalized();
+    if ((c.position - at).norm() <= spread) out.push_back(c);
+  }
+  return out;
+}
+
+// Fuses `contacts` into one point of `policy` (no gate) and returns its state.
+template <class Policy>
+typename Policy::State fuse_all(const Policy& policy,
+                                const std::vector<taxel::Contact<double>>& contacts) {
+  auto s = policy.init(contacts.front());
+  for (std::size_t i = 1; i < contacts.size(); ++i) {
+    REQUIRE(policy.fuse(s, contacts[i], std::uint32_t(i)));
+  }
+  return s;
+}
+}  // namespace
+
+TEST_CASE(
+    "Surfel at a crease and a corner: the patch's point, or Kalman's where other faces dominate",
+    "[fusion]") {
+  const tf::Surfel<double> surfel;
+  const tf::Kalman<double> kalman;
+  const taxel::Vec3d x = taxel::Vec3d::UnitX(), y = taxel::Vec3d::UnitY(),
+                     z = taxel::Vec3d::UnitZ();
+  // A point near a box's edge (two faces) or corner (three), its first contact on the top face
+  // (+z), its contacts spread 3 mm with 1 mm of lateral scatter and 0.05 rad of unstated normal
+  // noise. The contacts of the other faces are 90 degrees off the patch's normal.
+  for (const auto& faces : {std::vector<taxel::Vec3d>{z, x}, std::vector<taxel::Vec3d>{z, x, y}}) {
+    for (const std::uint64_t seed : {1u, 2u, 3u}) {
+      const auto all =
+          face_contacts(faces, taxel::Vec3d(0.5e-3, 0.5e-3, 0.5e-3), 3e-3, 1e-3, 0.05, 4000, seed);
+      std::vector<taxel::Contact<double>> top, others;
+      for (const auto& c : all) (c.normal->dot(z) > 0.7 ? top : others).push_back(c);
+      REQUIRE(top.size() > 100);
+      REQUIRE(others.size() > 100);
+      CAPTURE(faces.size(), seed);
+      SECTION("the patch holds the majority: the mean is the patch's point") {
+        // 300 top contacts, then 200 of the other faces (40 % apart): the mean is that of the
+        // top contacts alone, to rounding.
+        std::vector<taxel::Contact<double>> mixed(top.begin(), top.begin() + 300);
+        mixed.insert(mixed.end(), others.begin(), others.begin() + 200);
+        const auto s = fuse_all(surfel, mixed);
+        const auto patch =
+            fuse_all(surfel, std::vector<taxel::Contact<double>>(top.begin(), top.begin() + 300));
+        CHECK(s.xcount == 200.0);
+        CHECK(s.count == 300.0);
+        CHECK((surfel.mean(s) - surfel.mean(patch)).norm() < 1e-12);
+      }
+      SECTION("other faces hold 80 % or more: the mean is Kalman's fusion") {
+        // One top contact starts the point and its frame; every other contact is apart. With one
+        // patch contact, the patch's point is that contact and its information is the
+        // contact's, so the mean is exactly Kalman's.
+        std::vector<taxel::Contact<double>> mixed{top.front()};
+        mixed.insert(mixed.end(), others.begin(), others.begin() + 400);
+        const auto s = fuse_all(surfel, mixed);
+        const auto k = fuse_all(kalman, mixed);
+        CHECK(s.xcount == 400.0);
+        CHECK((surfel.mean(s) - kalman.mean(k)).norm() < 1e-9);
+      }
+    }
+  }
+}
