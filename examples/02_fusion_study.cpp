@@ -395,8 +395,9 @@ void independent_streams(bool quick) {
       "\nIndependent contact streams (sim::contact_stream): 0.3 mm along the normal and 1.0 mm "
       "across it, stated; normals turned by 0.05 rad per axis, not stated; a pose error of "
       "0.2 mm and 0.02 rad per frame, not stated; %zu contacts, 4 mm radius.\n"
-      "RMS / signed error [mm], and RMS over averaging's (surfel, scatter: "
-      "Surfel::Config::lateral_scatter, as these streams' covariances are):\n"
+      "Over the points of 5 or more contacts (a point of fewer is mostly a lone contact, the "
+      "same for every policy): RMS / signed error [mm], and RMS over averaging's (surfel, "
+      "scatter: Surfel::Config::lateral_scatter, as these streams' covariances are):\n"
       "shape          seed  average          kalman                   surfel                   "
       "surfel, scatter\n",
       n);
@@ -411,18 +412,19 @@ void independent_streams(bool quick) {
       const Row s = fuse<tf::Surfel<double>>(shape, contacts, n, {}, 4e-3);
       const Row c =
           fuse<tf::Surfel<double>>(shape, contacts, n, {}, 4e-3, false, {.lateral_scatter = true});
-      const double ra = a.m.error.rms;
+      const double ra = a.confirmed.rms;
       std::printf("%-14s %4d  %.3f / %+.3f", name, int(seed), 1e3 * ra,
-                  1e3 * a.m.error.signed_mean);
+                  1e3 * a.confirmed.signed_mean);
       for (const Row* r : {&k, &s, &c}) {
-        std::printf("   %.3f / %+.3f (%.2f)", 1e3 * r->m.error.rms, 1e3 * r->m.error.signed_mean,
-                    r->m.error.rms / ra);
+        std::printf("   %.3f / %+.3f (%.2f)", 1e3 * r->confirmed.rms,
+                    1e3 * r->confirmed.signed_mean, r->confirmed.rms / ra);
       }
       std::printf("\n");
     }
   };
   run("box", sim::Box());
   run("cylinder r30", sim::Cylinder(0.03, 0.05));
+  run("cone", sim::Cone());
   run("ellipsoid", sim::Ellipsoid());
   run("sphere r15", sim::Sphere(0.015));
   run("sphere r40", sim::Sphere(0.04));
