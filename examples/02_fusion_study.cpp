@@ -384,52 +384,190 @@ constexpr const char* kUsage =
     "against contacts. --threads N runs the shapes, seeds and checkpoints on N threads (default\n"
     "0: every core); the output is the same for any N.\n";
 
-// Contact streams that taxel's pad model did not make and Surfel was not tuned on
-// (sim::contact_stream): each contact states an anisotropic covariance and scatters by it, its
-// normal is the true one turned by noise it does not state, and each frame has a pose error no
-// covariance states. Prints RMS and signed error and the RMS ratio to averaging per shape and
-// seed.
-void independent_streams(bool quick) {
-  const std::size_t n = quick ? 20000 : 200000;
-  std::printf(
-      "\nIndependent contact streams (sim::contact_stream): 0.3 mm along the normal and 1.0 mm "
-      "across it, stated; normals turned by 0.05 rad per axis, not stated; a pose error of "
-      "0.2 mm and 0.02 rad per frame, not stated; %zu contacts, 4 mm radius.\n"
-      "Over the points of 5 or more contacts (a point of fewer is mostly a lone contact, the "
-      "same for every policy): RMS / signed error [mm], and RMS over averaging's (surfel, "
-      "scatter: Surfel::Config::lateral_scatter, as these streams' covariances are):\n"
-      "shape          seed  average          kalman                   surfel                   "
-      "surfel, scatter\n",
-      n);
-  const auto run = [&](const char* name, const auto& shape) {
-    for (const std::uint64_t seed : {0u, 1u}) {
-      sim::ContactStreamConfig cfg;
-      cfg.contacts = n;
-      cfg.seed = 1000 + seed;
-      const auto contacts = sim::contact_stream(shape, cfg);
-      const Row a = fuse<tf::Average<double>>(shape, contacts, n, {}, 4e-3);
-      const Row k = fuse<tf::Kalman<double>>(shape, contacts, n, {}, 4e-3);
-      const Row s = fuse<tf::Surfel<double>>(shape, contacts, n, {}, 4e-3);
-      const Row c =
-          fuse<tf::Surfel<double>>(shape, contacts, n, {}, 4e-3, false, {.lateral_scatter = true});
-      const double ra = a.confirmed.rms;
-      std::printf("%-14s %4d  %.3f / %+.3f", name, int(seed), 1e3 * ra,
-                  1e3 * a.confirmed.signed_mean);
-      for (const Row* r : {&k, &s, &c}) {
-        std::printf("   %.3f / %+.3f (%.2f)", 1e3 * r->confirmed.rms,
-                    1e3 * r->confirmed.signed_mean, r->confirmed.rms / ra);
-      }
-      std::printf("\n");
-    }
-  };
-  run("box", sim::Box());
-  run("cylinder r30", sim::Cylinder(0.03, 0.05));
-  run("cone", sim::Cone());
-  run("ellipsoid", sim::Ellipsoid());
-  run("sphere r15", sim::Sphere(0.015));
-  run("sphere r40", sim::Sphere(0.04));
-  run("torus", sim::Torus());
+// Distance of a surface point to the nearest crease (an edge, a rim, an apex) [m]; infinite on
+// smooth shapes.
+double crease_distance(const sim::Box& box, const Vec3d& p) {
+  const Vec3d d = box.half_extents - p.cwiseAbs();
+  double a[3] = {d[0], d[1], d[2]};
+  std::sort(a, a + 3);
+  return std::max(a[1], 0.0);  // a[0] is the face's own axis
+}
+double crease_distance(const sim::Cylinder& c, const Vec3d& p) {
+  const double r = std::hypot(p.x(), p.y());
+  if (std::abs(r - c.radius) < 1e-9 * c.radius) return c.half_height - std::abs(p.z());
+  return c.radius - r;
+}
+double crease_distance(const sim::Cone& c, const Vec3d& p) {
+  const Eigen::Vector2d q(std::hypot(p.x(), p.y()), p.z());
+  return std::min((q - Eigen::Vector2d(c.radius, -0.5 * c.height)).norm(),
+                  (q - Eigen::Vector2d(0.0, 0.5 * c.height)).norm());
+}
+template <class Shape>
+double crease_distance(const Shape&, const Vec3d&) {
+  return std::numeric_limits<double>::infinity();
+}
 
+// One policy on one stream of the robustness matrix: over the points of 5 or more contacts,
+// RMS and signed error [m], and the RMS of those within `kCreaseBand` of a crease.
+struct MatrixFit {
+  double rms = 0, signed_mean = 0, crease_rms = 0;
+  std::size_t crease_points = 0;
+};
+constexpr double kCreaseBand = 4e-3;  // the association radius
+
+template <class Policy, class Shape>
+MatrixFit matrix_fit(const Shape& shape, const std::vector<Contact<double>>& contacts,
+                     std::size_t count, const typename Policy::Config& policy = {}) {
+  tf::ContactCloud<Policy, index::VoxelHash<double>> cloud(
+      {.association_radius = 4e-3, .fusion = policy});
+  cloud.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) (void)cloud.insert(contacts[i]);
+  const auto points = cloud.to_point_cloud({5}).points;
+  MatrixFit f;
+  double s2 = 0, s = 0, c2 = 0;
+  for (const Vec3d& x : points) {
+    const double d = shape.signed_distance(x);
+    s2 += d * d;
+    s += d;
+    if (crease_distance(shape, shape.closest_point(x)) < kCreaseBand) {
+      c2 += d * d;
+      ++f.crease_points;
+    }
+  }
+  const double m = std::max<double>(1.0, double(points.size()));
+  f.rms = std::sqrt(s2 / m);
+  f.signed_mean = s / m;
+  f.crease_rms = f.crease_points ? std::sqrt(c2 / double(f.crease_points)) : 0.0;
+  return f;
+}
+
+// A cell of the robustness matrix: the stream's settings, changed one factor at a time from the
+// default (first) and all adverse at once (last).
+struct MatrixCell {
+  const char* name;
+  sim::ContactStreamConfig stream;
+};
+
+std::vector<MatrixCell> matrix_cells() {
+  const sim::ContactStreamConfig d{};  // 1 mm lateral, 0.05 rad unstated, sharp, no footprint
+  std::vector<MatrixCell> cells{{"default", d}};
+  const auto with = [&](const char* name, auto change) {
+    sim::ContactStreamConfig c = d;
+    change(c);
+    cells.push_back({name, c});
+  };
+  with("lateral 0", [](auto& c) { c.sigma_lateral = 0; });
+  with("lateral 0.5 mm", [](auto& c) { c.sigma_lateral = 0.5e-3; });
+  with("lateral 1.5 mm", [](auto& c) { c.sigma_lateral = 1.5e-3; });
+  with("normals exact", [](auto& c) { c.normal_noise = 0; });
+  with("normals 0.1 rad", [](auto& c) { c.normal_noise = 0.1; });
+  with("normal_sigma stated", [](auto& c) { c.state_normal_sigma = true; });
+  with("footprint 2x2", [](auto& c) { c.footprint = 2; });
+  with("depth-map normals", [](auto& c) { c.normal_smoothing = 1.7e-3; });
+  with("all adverse", [](auto& c) {
+    c.sigma_lateral = 1.5e-3;
+    c.normal_noise = 0.1;
+    c.footprint = 2;
+    c.normal_smoothing = 1.7e-3;
+  });
+  return cells;
+}
+
+// The robustness matrix (sim::contact_stream): every cell on seven shapes and `seeds` seeds,
+// averaging, Kalman, Surfel and Surfel with lateral_scatter. Prints a row per shape and seed,
+// and per cell the worst ratios and signed errors.
+void robustness_matrix(bool quick, unsigned threads) {
+  const std::size_t n = quick ? 20000 : 200000, n_short = n / 10;
+  const int seeds = quick ? 1 : 3;
+  const std::vector<MatrixCell> cells = matrix_cells();
+  const char* const shape_names[] = {"box",        "cylinder r30", "cone",  "ellipsoid",
+                                     "sphere r15", "sphere r40",   "torus"};
+  constexpr std::size_t kShapes = 7;
+  // Per job: average, kalman, surfel, surfel with lateral_scatter; then both Surfels at n / 10.
+  struct Job {
+    MatrixFit fit[6];
+  };
+  std::vector<Job> results(cells.size() * kShapes * std::size_t(seeds));
+  parallel_for(results.size(), threads, [&](std::size_t j) {
+    const std::size_t cell = j / (kShapes * seeds), shape = j / seeds % kShapes;
+    sim::ContactStreamConfig cfg = cells[cell].stream;
+    cfg.contacts = n;
+    cfg.seed = 1000 + j % seeds;
+    const auto run = [&](const auto& sh) {
+      const auto contacts = sim::contact_stream(sh, cfg);
+      const tf::Surfel<double>::Config lateral{.lateral_scatter = true};
+      Job& r = results[j];
+      r.fit[0] = matrix_fit<tf::Average<double>>(sh, contacts, n);
+      r.fit[1] = matrix_fit<tf::Kalman<double>>(sh, contacts, n);
+      r.fit[2] = matrix_fit<tf::Surfel<double>>(sh, contacts, n);
+      r.fit[3] = matrix_fit<tf::Surfel<double>>(sh, contacts, n, lateral);
+      r.fit[4] = matrix_fit<tf::Surfel<double>>(sh, contacts, n_short);
+      r.fit[5] = matrix_fit<tf::Surfel<double>>(sh, contacts, n_short, lateral);
+    };
+    switch (shape) {
+      case 0: run(sim::Box()); break;
+      case 1: run(sim::Cylinder(0.03, 0.05)); break;
+      case 2: run(sim::Cone()); break;
+      case 3: run(sim::Ellipsoid()); break;
+      case 4: run(sim::Sphere(0.015)); break;
+      case 5: run(sim::Sphere(0.04)); break;
+      default: run(sim::Torus()); break;
+    }
+  });
+  std::printf(
+      "\nRobustness matrix (sim::contact_stream, %zu contacts, 4 mm radius, points of 5+ "
+      "contacts; a point of fewer is mostly a lone contact, the same for every policy). Default "
+      "cell: 14x6 sites at 3.4 mm, 0.3 mm along the normal and 1.0 mm across it, stated; normals "
+      "sharp, turned by 0.05 rad per axis, not stated; pose error 0.2 mm and 0.02 rad per frame, "
+      "not stated. Each other cell changes one factor, the last all adverse at once.\n"
+      "RMS / signed error [mm], RMS over averaging's in brackets; crease: RMS of the points "
+      "within 4 mm of an edge, rim or apex; lateral: Surfel::Config::lateral_scatter.\n",
+      n);
+  const bool smooth[kShapes] = {false, false, false, true, true, true, true};
+  for (std::size_t cell = 0; cell < cells.size(); ++cell) {
+    std::printf(
+        "\n[%s]\nshape          seed  average          kalman                  surfel             "
+        "     surfel, lateral        | crease: kalman surfel lateral\n",
+        cells[cell].name);
+    double worst_avg[2] = {0, 0}, worst_kal[2] = {0, 0}, worst_signed[2] = {0, 0},
+           worst_rise[2] = {-1, -1};
+    for (std::size_t shape = 0; shape < kShapes; ++shape) {
+      for (int seed = 0; seed < seeds; ++seed) {
+        const Job& r = results[(cell * kShapes + shape) * std::size_t(seeds) + std::size_t(seed)];
+        const double ra = r.fit[0].rms;
+        std::printf("%-14s %4d  %.3f / %+.3f", shape_names[shape], seed, 1e3 * ra,
+                    1e3 * r.fit[0].signed_mean);
+        for (int p = 1; p < 4; ++p) {
+          std::printf("   %.3f / %+.3f (%.2f)", 1e3 * r.fit[p].rms, 1e3 * r.fit[p].signed_mean,
+                      r.fit[p].rms / ra);
+        }
+        if (r.fit[1].crease_points > 0) {
+          std::printf(" | %.3f %.3f %.3f", 1e3 * r.fit[1].crease_rms, 1e3 * r.fit[2].crease_rms,
+                      1e3 * r.fit[3].crease_rms);
+        }
+        std::printf("\n");
+        for (int k = 0; k < 2; ++k) {
+          const MatrixFit& f = r.fit[2 + k];
+          worst_avg[k] = std::max(worst_avg[k], f.rms / ra);
+          worst_kal[k] = std::max(worst_kal[k], f.rms / r.fit[1].rms);
+          if (smooth[shape] && std::abs(f.signed_mean) > std::abs(worst_signed[k])) {
+            worst_signed[k] = f.signed_mean;
+          }
+          worst_rise[k] = std::max(worst_rise[k], f.rms / r.fit[4 + k].rms - 1.0);
+        }
+      }
+    }
+    for (int k = 0; k < 2; ++k) {
+      std::printf(
+          "%s: worst RMS over averaging's %.2f, over Kalman's %.2f; largest signed error on "
+          "smooth shapes %+.3f mm; RMS from %zu to %zu contacts: largest rise %+.0f %%\n",
+          k == 0 ? "  surfel" : "  surfel, lateral", worst_avg[k], worst_kal[k],
+          1e3 * worst_signed[k], n_short, n, 100.0 * worst_rise[k]);
+    }
+  }
+}
+
+void footprint_table(bool quick) {
   // A real tactel reports the indentation averaged over its footprint, not at its centre
   // (read_pad's footprint): the pad model with and without it, sliding on two spheres.
   std::printf(
@@ -815,7 +953,8 @@ int main(int argc, char** argv) try {
     }
     std::printf("  (largest rise %+.0f %%)\n", 100.0 * largest_rise_of_kept_points(errors));
   }
-  independent_streams(quick);
+  robustness_matrix(quick, threads);
+  footprint_table(quick);
   std::printf("wrote %s/*.ply and %s/error_vs_contacts.svg\n", out.c_str(), out.c_str());
   return 0;
 } catch (const std::exception& e) {

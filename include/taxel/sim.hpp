@@ -2,6 +2,7 @@
 // Umbrella header of taxel::sim.
 #pragma once
 
+#include "taxel/sim/compression.hpp"
 #include "taxel/sim/contact_stream.hpp"
 #include "taxel/sim/exploration.hpp"
 #include "taxel/sim/metrics.hpp"

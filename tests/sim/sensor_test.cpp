@@ -412,6 +412,84 @@ TEST_CASE(
   const double expected = std::sqrt(std::numbers::pi / 2) *
                           std::sqrt(2 * 0.05 * 0.05 + 2.0 / 3.0 * 0.02 * 0.02) / std::sqrt(2.0);
   CHECK(angle / double(m) == Approx(expected).epsilon(0.1));
-  cfg.sigma_lateral = 0;
+  cfg.sigma_lateral = -1e-3;
   CHECK_THROWS_WITH(ts::contact_stream(box, cfg), Catch::Contains("sigma_lateral"));
+  cfg.sigma_lateral = 1e-3;
+  cfg.footprint = 5;
+  CHECK_THROWS_WITH(ts::contact_stream(box, cfg), Catch::Contains("footprint"));
+  cfg.footprint = 1;
+  cfg.normal_smoothing = -1;
+  CHECK_THROWS_WITH(ts::contact_stream(box, cfg), Catch::Contains("normal_smoothing"));
+}
+
+TEST_CASE("contact_stream: stated normal noise, depth-map normals, footprint, no lateral scatter",
+          "[sim][stream]") {
+  ts::ContactStreamConfig cfg;
+  cfg.contacts = 5000;
+  cfg.seed = 9;
+  SECTION("normal_sigma stated: the per-axis tilt of normal noise and pose error") {
+    cfg.state_normal_sigma = true;
+    for (const auto& c : ts::contact_stream(ts::Sphere(0.03), cfg)) {
+      CHECK(c.normal_sigma == Approx(std::sqrt(0.05 * 0.05 + 0.02 * 0.02 / 3)));
+    }
+  }
+  SECTION("no lateral scatter: positions on the surface across the normal") {
+    cfg.sigma_lateral = 0;
+    cfg.sigma_normal = 1e-9;
+    cfg.pose_position = cfg.pose_angle = 0;
+    const ts::Sphere sphere(0.03);
+    for (const auto& c : ts::contact_stream(sphere, cfg)) {
+      CHECK(std::abs(sphere.signed_distance(c.position)) < 1e-8);
+      // Stated isotropic at sigma_normal.
+      CHECK(c.covariance.isApprox(Eigen::Matrix3d::Identity() * 1e-18, 1e-6));
+    }
+  }
+  SECTION("depth-map normals round a box's edges, and are exact on its faces") {
+    const ts::Box box(Vec3d(0.06, 0.05, 0.04));
+    cfg.normal_noise = cfg.pose_angle = cfg.pose_position = 0;
+    cfg.sigma_lateral = 0;
+    cfg.sigma_normal = 1e-9;
+    cfg.normal_smoothing = 1e-3;
+    std::size_t rounded = 0, on_faces = 0;
+    for (const auto& c : ts::contact_stream(box, cfg)) {
+      const Vec3d d = box.half_extents - c.position.cwiseAbs();
+      const bool face = (d.array() < 1.5e-3).count() == 1;  // > 1.5 mm from every edge
+      const bool exact = c.normal->cwiseAbs().maxCoeff() == 1.0;
+      if (face) {
+        ++on_faces;
+        CHECK(exact);
+      }
+      if (!exact) {
+        ++rounded;
+        CHECK((d.array() < 1.1e-3).count() >= 2);  // within the smoothing of an edge
+      }
+    }
+    CHECK(on_faces > 1000);
+    CHECK(rounded > 20);
+  }
+  SECTION("footprint: fully touching sites sit inside a sphere by pitch^2 / (12 R)") {
+    // A small pad pressed 2.5 mm deep into a 40 mm sphere: every site touches over its whole
+    // footprint, and reads the mean compression, pitch^2 / (12 R) less than at its centre
+    // (exact for a paraboloid with 2 x 2 Gauss points); at footprint 1 it reads its centre.
+    const double R = 0.04;
+    const ts::Sphere sphere(R);
+    cfg.rows = cfg.cols = 3;
+    cfg.indentation = 2.5e-3;
+    cfg.sigma_lateral = 0;
+    cfg.sigma_normal = 1e-9;
+    cfg.normal_noise = cfg.pose_angle = cfg.pose_position = 0;
+    for (const int footprint : {1, 2, 3}) {
+      cfg.footprint = footprint;
+      double sum = 0;
+      const auto contacts = ts::contact_stream(sphere, cfg);
+      for (const auto& c : contacts) sum += sphere.signed_distance(c.position);
+      const double mean = sum / double(contacts.size());
+      CAPTURE(footprint, mean);
+      if (footprint == 1) {
+        CHECK(std::abs(mean) < 1e-9);
+      } else {
+        CHECK(mean == Approx(-cfg.pitch * cfg.pitch / (12 * R)).epsilon(0.05));
+      }
+    }
+  }
 }

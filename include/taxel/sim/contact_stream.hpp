@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "taxel/core/contact.hpp"
+#include "taxel/sim/compression.hpp"
 #include "taxel/sim/sampling.hpp"
 #include "taxel/sim/shapes.hpp"
 
@@ -29,8 +30,22 @@ struct ContactStreamConfig {
   double pitch = 3.4e-3;          ///< spacing of the sites, > 0
   double indentation = 1e-3;      ///< a site touches where the surface is this close, > 0
   double sigma_normal = 0.3e-3;   ///< stated and drawn along the true normal, > 0
-  double sigma_lateral = 1.0e-3;  ///< stated and drawn across it (the site's footprint), > 0
-  double normal_noise = 0.05;     ///< the reported normal turns by this about each axis, >= 0
+  /// Drawn across the normal and stated there, >= 0; 0: no lateral scatter, and the stated
+  /// covariance is sigma_normal^2 across as well.
+  double sigma_lateral = 1.0e-3;
+  double normal_noise = 0.05;  ///< the reported normal turns by this about each axis, >= 0
+  /// Whether contacts state their normals' noise (normal_sigma = the per-axis tilt of the
+  /// normal noise and the pose error, sqrt(normal_noise^2 + pose_angle^2 / 3)); otherwise 0.
+  bool state_normal_sigma = false;
+  /// 0: sharp normals (the true one at the contact). > 0: the normal is the mean of the true
+  /// normals over a square of this half side around the contact in its tangent plane (3 x 3
+  /// points), as a normal taken from a depth map is: it rounds a crease over that width.
+  double normal_smoothing = 0.0;
+  /// Samples per side of a site's pitch x pitch footprint, in [1, 4]: 1 reads the surface at
+  /// the site; n >= 2 reads the mean compression over the footprint along the pad normal (n x n
+  /// Gauss-Legendre points, a sample that does not touch reading 0), as a tactel does, and
+  /// places the contact at the site pushed back by that mean.
+  int footprint = 1;
   double pose_position = 0.2e-3;  ///< per-frame pose error, translation per axis, >= 0
   double pose_angle = 0.02;       ///< and rotation about a random axis, >= 0
   int stroke_frames = 20;         ///< frames of a stroke, >= 1 (a press has one)
@@ -48,7 +63,9 @@ struct ContactStreamConfig {
     need(pitch > 0 && pitch <= 1, "pitch in (0, 1] m");
     need(indentation > 0 && indentation <= 1, "indentation in (0, 1] m");
     need(sigma_normal > 0 && sigma_normal <= 1, "sigma_normal in (0, 1] m");
-    need(sigma_lateral > 0 && sigma_lateral <= 1, "sigma_lateral in (0, 1] m");
+    need(sigma_lateral >= 0 && sigma_lateral <= 1, "sigma_lateral in [0, 1] m");
+    need(normal_smoothing >= 0 && normal_smoothing <= 1, "normal_smoothing in [0, 1] m");
+    need(footprint >= 1 && footprint <= 4, "footprint in [1, 4] samples per side");
     need(normal_noise >= 0 && normal_noise <= 1, "normal_noise in [0, 1] rad");
     need(pose_position >= 0 && pose_position <= 1, "pose_position in [0, 1] m");
     need(pose_angle >= 0 && pose_angle <= 1, "pose_angle in [0, 1] rad");
@@ -113,21 +130,56 @@ std::vector<Contact<double>> contact_stream(const Sh& shape, const ContactStream
               centre +
               cfg.pitch * ((c - 0.5 * (cfg.cols - 1)) * vc + (r - 0.5 * (cfg.rows - 1)) * uc) -
               cfg.indentation * nc;
-          if (!(shape.signed_distance(site) < 0.0)) continue;  // this site does not touch
-          const Vec3d q = shape.closest_point(site);
+          Vec3d q;
+          if (cfg.footprint == 1) {
+            if (!(shape.signed_distance(site) < 0.0)) continue;  // this site does not touch
+            q = shape.closest_point(site);
+          } else {
+            // The mean compression over the footprint (read_pad's model), the site pushed back
+            // by it.
+            const int k = cfg.footprint - 1;
+            double depth = 0.0;
+            bool touching = false;
+            for (int i = 0; i < cfg.footprint; ++i) {
+              for (int j = 0; j < cfg.footprint; ++j) {
+                const Vec3d at = site + cfg.pitch * (kGaussNode[k][i] * uc + kGaussNode[k][j] * vc);
+                if (!(shape.signed_distance(at) < 0.0)) continue;
+                touching = true;
+                depth += kGaussWeight[k][i] * kGaussWeight[k][j] * compression(shape, at, nc);
+              }
+            }
+            if (!touching) continue;
+            q = site + depth * nc;
+          }
           const Vec3d nq = shape.normal(q);
           const Vec3d t1 = nq.unitOrthogonal(), t2 = nq.cross(t1);
+          const double across = cfg.sigma_lateral > 0 ? cfg.sigma_lateral : cfg.sigma_normal;
           Contact<double> k;
           k.position = q + cfg.sigma_normal * gauss(rng) * nq +
                        cfg.sigma_lateral * (gauss(rng) * t1 + gauss(rng) * t2);
           k.covariance = cfg.sigma_normal * cfg.sigma_normal * nq * nq.transpose() +
-                         cfg.sigma_lateral * cfg.sigma_lateral *
-                             (Eigen::Matrix3d::Identity() - nq * nq.transpose());
-          Vec3d reported = small_rotation(cfg.normal_noise) * nq;
+                         across * across * (Eigen::Matrix3d::Identity() - nq * nq.transpose());
+          Vec3d truth = nq;
+          if (cfg.normal_smoothing > 0) {
+            const Vec3d cq = shape.closest_point(q);
+            truth = Vec3d::Zero();
+            for (int i = -1; i <= 1; ++i) {
+              for (int j = -1; j <= 1; ++j) {
+                truth += shape.normal(shape.closest_point(
+                    cq + cfg.normal_smoothing * (double(i) * t1 + double(j) * t2)));
+              }
+            }
+            truth.normalize();
+          }
+          Vec3d reported = small_rotation(cfg.normal_noise) * truth;
           // The frame's pose error moves the whole frame about the touch point.
           k.position = pose_rotation * (k.position - centre) + centre + pose_shift;
           reported = pose_rotation * reported;
           k.normal = reported.normalized();
+          if (cfg.state_normal_sigma) {
+            k.normal_sigma = std::sqrt(cfg.normal_noise * cfg.normal_noise +
+                                       cfg.pose_angle * cfg.pose_angle / 3.0);
+          }
           k.time = time;
           out.push_back(k);
           if (out.size() >= cfg.contacts) return out;

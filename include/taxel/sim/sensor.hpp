@@ -18,6 +18,7 @@
 #include "taxel/core/types.hpp"
 #include "taxel/sensor/contacts.hpp"
 #include "taxel/sensor/pad.hpp"
+#include "taxel/sim/compression.hpp"
 #include "taxel/sim/sampling.hpp"
 #include "taxel/sim/shapes.hpp"
 
@@ -73,20 +74,6 @@ struct PadReading {
   bool touching() const { return (counts > 0).any(); }
 };
 
-/// How far a tactel at `at`, inside the shape, is pushed back along `back` (unit) until it leaves
-/// the shape: the pad's compression there [m]. Sphere tracing: each step moves by the distance to
-/// the surface, which never overshoots it.
-template <Shape Sh>
-double compression(const Sh& shape, const Vec3d& at, const Vec3d& back) {
-  double t = 0.0;
-  for (int it = 0; it < 200; ++it) {
-    const double d = -shape.signed_distance(at + t * back);
-    if (d <= 1e-12) break;
-    t += std::max(d, 1e-10);
-  }
-  return t;
-}
-
 /// Reads a pad pressed against `shape` (in world coordinates; wrap a placed shape in `Posed`)
 /// at `true_pose`, drawing the frame's kinematic noise and the tactels' depth noise from `rng`.
 /// A point of the pad inside the shape is compressed by the distance along the pad normal back
@@ -106,17 +93,6 @@ PadReading read_pad(const Sh& shape, const SensorModel& model, const Eigen::Isom
   if (footprint < 1 || footprint > 4) {
     throw std::invalid_argument("read_pad: footprint must be in [1, 4] samples per side");
   }
-  // Gauss-Legendre nodes on [-1/2, 1/2] and their weights (summing to 1), per footprint.
-  static constexpr double kNode[4][4] = {
-      {0.0},
-      {-0.28867513459481287, 0.28867513459481287},
-      {-0.3872983346207417, 0.0, 0.3872983346207417},
-      {-0.43056815579702629, -0.16999052179242813, 0.16999052179242813, 0.43056815579702629}};
-  static constexpr double kWeight[4][4] = {
-      {1.0},
-      {0.5, 0.5},
-      {0.2777777777777778, 0.4444444444444444, 0.2777777777777778},
-      {0.17392742256872692, 0.32607257743127307, 0.32607257743127307, 0.17392742256872692}};
   const int k = footprint - 1;
   std::normal_distribution<double> gauss(0.0, 1.0);
   const PadGeometry& g = model.geometry;
@@ -137,11 +113,11 @@ PadReading read_pad(const Sh& shape, const SensorModel& model, const Eigen::Isom
         bool touching = false;
         for (int i = 0; i < footprint; ++i) {
           for (int j = 0; j < footprint; ++j) {
-            const Vec3d at =
-                true_pose * (g.tactel(r, c) + g.pitch * Vec3d(kNode[k][j], kNode[k][i], 0.0));
+            const Vec3d at = true_pose * (g.tactel(r, c) +
+                                          g.pitch * Vec3d(kGaussNode[k][j], kGaussNode[k][i], 0.0));
             if (!(shape.signed_distance(at) < 0.0)) continue;
             touching = true;
-            depth += kWeight[k][i] * kWeight[k][j] * compression(shape, at, back);
+            depth += kGaussWeight[k][i] * kGaussWeight[k][j] * compression(shape, at, back);
           }
         }
         if (!touching) continue;
