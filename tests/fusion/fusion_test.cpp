@@ -1141,3 +1141,58 @@ TEST_CASE(
     }
   }
 }
+
+TEST_CASE("Surfel: a crease inside the patch moves the point to Kalman's; a sphere does not",
+          "[fusion]") {
+  const tf::Kalman<double> kalman;
+  SECTION("two planes 0.5 rad apart, normals as good as stated") {
+    // Every contact is within max_normal_angle (1.2 rad) of the others, so all enter the
+    // curvature fit, whose slopes jump across the crease: the residual is far beyond the
+    // stated 0.01 rad, and the point is Kalman's, whose tight planes meet on the crease.
+    const tf::Surfel<double> sharp({.normal_sigma = 0.01});
+    const taxel::Vec3d a(std::sin(-0.25), 0, std::cos(0.25)), b(std::sin(0.25), 0, std::cos(0.25));
+    for (const std::uint64_t seed : {1u, 2u, 3u}) {
+      const auto contacts =
+          face_contacts({a, b}, taxel::Vec3d(0.3e-3, 0, 0), 3e-3, 1e-3, 0.01, 3000, seed);
+      const auto s = fuse_all(sharp, contacts);
+      const auto k = fuse_all(kalman, contacts);
+      double h[3];
+      sharp.fit_curvature(s, h);
+      CAPTURE(seed);
+      CHECK(s.xcount == 0.0);
+      CHECK(sharp.crease_share(s, h) == 1.0);
+      CHECK((sharp.mean(s) - kalman.mean(k)).norm() < 1e-9);
+    }
+  }
+  SECTION("a 15 mm sphere's cap, normals turned by normal_sigma") {
+    // The slopes follow H u: no crease, and the point stays on the sphere where Kalman's is
+    // outside.
+    for (const double noise : {0.01, 0.05}) {
+      const tf::Surfel<double> p({.normal_sigma = noise});
+      std::mt19937_64 rng(5);
+      std::normal_distribution<double> g(0.0, 1.0);
+      std::uniform_real_distribution<double> u(-3e-3, 3e-3);
+      std::vector<taxel::Contact<double>> contacts;
+      const double R = 0.015;
+      for (int i = 0; i < 3000; ++i) {
+        const double px = u(rng), py = u(rng);
+        const taxel::Vec3d q(px, py, std::sqrt(R * R - px * px - py * py)), n = q / R;
+        taxel::Contact<double> c;
+        c.position = q + 0.3e-3 * g(rng) * n;
+        c.covariance = taxel::pad_covariance<double>(n, 0.3e-3, 1e-3);
+        const Eigen::Matrix3d turn(Eigen::AngleAxisd(noise * g(rng), taxel::Vec3d::UnitX()) *
+                                   Eigen::AngleAxisd(noise * g(rng), taxel::Vec3d::UnitY()));
+        c.normal = (turn * n).normalized();
+        contacts.push_back(c);
+      }
+      const auto s = fuse_all(p, contacts);
+      const auto k = fuse_all(kalman, contacts);
+      double h[3];
+      p.fit_curvature(s, h);
+      CAPTURE(noise, p.mean(s).norm() - R, kalman.mean(k).norm() - R);
+      CHECK(p.crease_share(s, h) == 0.0);
+      CHECK(std::abs(p.mean(s).norm() - R) < 0.02e-3);
+      CHECK(kalman.mean(k).norm() - R > 0.05e-3);
+    }
+  }
+}

@@ -54,6 +54,12 @@ namespace taxel::fusion {
 /// J^-1 ((J - J_x) d + eta_x), Kalman's tight planes meeting across the crease; fully at 80 %.
 /// (Fusing them at every share measured worse: on a box and a cone one face's lateral
 /// information is another's height information, and pulls a point on the crease inside.)
+/// A crease shallower than `max_normal_angle` (or one a depth-map normal rounds) puts every
+/// contact in the patch, and the slopes jump across it where a quadric has them change
+/// linearly. Where the slopes' residual about the fitted H exceeds 9 times the variance the
+/// normals state, the mean moves towards plain Kalman's (every contact unturned, J_k and
+/// eta_k), fully at 25 times (`crease_share`). With sharp normals this changes little; with
+/// normals that round a box's edges it brings Surfel level with Kalman there.
 /// On a plane with exact normals (all equal) the rotation is the identity and H = 0: the
 /// result is `Kalman`'s, up to rounding.
 /// The offsets are measured positions: their own noise is not removed from M (the contacts
@@ -66,7 +72,7 @@ namespace taxel::fusion {
 /// which does not depend on the state. P = J^-1 is formed when asked for (`covariance`), and
 /// in each update only with process noise or a gate. A covariance whose inverse overflows
 /// (a variance below about 1e-308 m^2) makes the point non-finite, and `ContactCloud` refuses
-/// the contact. State: 480 bytes (double). No allocation.
+/// the contact. State: 576 bytes (double). No allocation.
 template <Scalar S>
 struct Surfel {
   /// The floating-point type of positions and covariances (float or double).
@@ -124,6 +130,11 @@ struct Surfel {
     S xinfo[6] = {};
     Vec3<S> xeta = Vec3<S>::Zero();  ///< see xinfo
     S xcount = S(0);                 ///< contacts apart from the patch
+    S sss[3] = {};                   ///< v-weighted sums of s_x^2, s_x s_y, s_y^2 [-]
+    /// Information [1/m^2] and information vector [1/m] of every contact unturned: plain
+    /// Kalman's, which the mean moves to where one smooth patch does not fit the slopes.
+    S kinfo[6] = {};
+    Vec3<S> keta = Vec3<S>::Zero();  ///< see kinfo
   };
   static constexpr bool kMerges =
       true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
@@ -164,6 +175,7 @@ struct Surfel {
     } else {
       inverse(c.covariance, s.info);
     }
+    for (int i = 0; i < 6; ++i) s.kinfo[i] = s.info[i];
     if (c.normal) {
       start_frame(s, c);
     } else {
@@ -178,6 +190,15 @@ struct Surfel {
     S ci[6];  // the contact's information R^-1: it does not depend on the state
     inverse(c.covariance, ci);
     const Vec3<S> d = c.position - s.origin;  // the offset from the point's origin
+    if (!fuse_patch(s, c, d, ci)) return false;
+    for (int i = 0; i < 6; ++i) s.kinfo[i] += ci[i];
+    s.keta += times(ci, d);
+    return true;
+  }
+
+ private:
+  // The update of everything but plain Kalman's pair (kinfo, keta).
+  bool fuse_patch(State& s, const Contact<S>& c, const Vec3<S>& d, const S ci[6]) const {
     if (!c.normal) return filter_apart(s, d, ci);
     if (s.count == S(0)) {
       if (!filter(s, d, ci)) return false;
@@ -222,6 +243,7 @@ struct Surfel {
     return true;
   }
 
+ public:
   /// The surface point [m]: the point of the quadric fitted to the contacts above their
   /// weighted centroid in the tangent plane (`filter_mean` until a contact with a normal
   /// arrives).
@@ -258,8 +280,39 @@ struct Surfel {
       const S f = std::min((apart - kApartLow) / (kApartHigh - kApartLow), S(1));
       d += f * (times(p, times(ja, d) + s.xeta) - d);
     }
+    const S k = crease_share(s, h);
+    if (k > S(0)) {
+      S p[6];
+      inverse(s.kinfo, p);
+      d += k * (times(p, s.keta) - d);
+    }
     return s.origin + d;
   }
+  /// How far the mean moves towards plain Kalman's, in [0, 1], given the fitted curvature h
+  /// (`fit_curvature`): the residual of the slopes about h, per slope and weighted as the fit
+  /// weighs them, over the variance the normals state (normal_sigma^2, or a contact's larger
+  /// sigma_c^2); 0 up to kCreaseLow times, 1 from kCreaseHigh times, linear between. 0 with
+  /// fewer than six contacts in the sums.
+  S crease_share(const State& s, const S h[3]) const noexcept {
+    if (s.count < S(6) || !(s.vweight >= std::numeric_limits<S>::min())) return S(0);
+    const S inv = S(1) / s.vweight;
+    const S ux = s.vu[0] * inv, uy = s.vu[1] * inv, sx = s.ss[0] * inv, sy = s.ss[1] * inv;
+    const S cuu[3] = {s.vuu[0] * inv - ux * ux, s.vuu[1] * inv - ux * uy, s.vuu[2] * inv - uy * uy};
+    const S css[3] = {s.sss[0] * inv - sx * sx, s.sss[1] * inv - sx * sy, s.sss[2] * inv - sy * sy};
+    const S csu[4] = {s.ssu[0] * inv - sx * ux, s.ssu[1] * inv - sx * uy, s.ssu[2] * inv - sy * ux,
+                      s.ssu[3] * inv - sy * uy};
+    // The residual covariance of s - H u: C_ss - 2 H C_us + H C_uu H; half its trace.
+    const S hc = h[0] * csu[0] + h[1] * (csu[1] + csu[2]) + h[2] * csu[3];
+    const S hh0 = h[0] * h[0] + h[1] * h[1], hh1 = h[0] * h[1] + h[1] * h[2];
+    const S hh2 = h[1] * h[1] + h[2] * h[2];
+    const S hch = hh0 * cuu[0] + S(2) * hh1 * cuu[1] + hh2 * cuu[2];
+    const S r2 = S(0.5) * (css[0] + css[2] - S(2) * hc + hch);
+    const S stated = config_.normal_sigma * config_.normal_sigma * s.weight * inv;
+    return std::clamp((r2 / stated - kCreaseLow) / (kCreaseHigh - kCreaseLow), S(0), S(1));
+  }
+  /// The bounds of `crease_share`, in multiples of the stated slope variance.
+  static constexpr S kCreaseLow = S(9);
+  static constexpr S kCreaseHigh = S(25);  ///< see kCreaseLow
   /// Shares of a point's contacts apart from its patch between which its mean moves from
   /// the patch's point to the fusion with them (see the class comment).
   static constexpr S kApartLow = S(0.5);
@@ -372,6 +425,7 @@ struct Surfel {
         inverse(p, s.info);
         s.eta = times(s.info, mu);
         if (s.xcount > S(0)) predict(s.xinfo, s.xeta);
+        predict(s.kinfo, s.keta);
       }
     }
     for (int i = 0; i < 6; ++i) s.info[i] += ri[i];
@@ -453,6 +507,9 @@ struct Surfel {
     s.ssu[1] += v * sx * uy;
     s.ssu[2] += v * sy * ux;
     s.ssu[3] += v * sy * uy;
+    s.sss[0] += v * sx * sx;
+    s.sss[1] += v * sx * sy;
+    s.sss[2] += v * sy * sy;
   }
 
   Config config_{};
