@@ -1142,7 +1142,7 @@ TEST_CASE(
   }
 }
 
-TEST_CASE("Surfel: a crease inside the patch moves the point to Kalman's; a sphere does not",
+TEST_CASE("Surfel: a crease inside the patch moves the point to Kalman's, a sphere's cap does not",
           "[fusion]") {
   const tf::Kalman<double> kalman;
   SECTION("two planes 0.5 rad apart, normals as good as stated") {
