@@ -1196,3 +1196,41 @@ TEST_CASE("Surfel: a crease inside the patch moves the point to Kalman's, a sphe
     }
   }
 }
+
+TEST_CASE("Surfel keeps a point from lying outside the plane of the contacts apart from it",
+          "[fusion]") {
+  // A point on a box's top face (+z) next to its edge along y (the solid is x <= 0, z <= 0):
+  // its top contacts were reported past the edge, at x = 0.2-2.5 mm, as lateral scatter puts
+  // them. 60 contacts of the side face (+x) are apart (14 %, too few for the blend). The patch
+  // alone places the point beyond the edge; the side face's plane, through their Kalman mean,
+  // bounds it.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> beyond(0.2e-3, 2.5e-3), along(-2e-3, 2e-3),
+      down(-3e-3, 0.0);
+  const taxel::Vec3d x = taxel::Vec3d::UnitX(), z = taxel::Vec3d::UnitZ();
+  std::vector<taxel::Contact<double>> top, side;
+  for (int i = 0; i < 360; ++i) {
+    const bool on_top = i < 300;
+    const taxel::Vec3d n = on_top ? z : x;
+    taxel::Contact<double> c;
+    c.position = on_top ? taxel::Vec3d(beyond(rng), along(rng), 0.3e-3 * g(rng))
+                        : taxel::Vec3d(0.3e-3 * g(rng), along(rng), down(rng));
+    c.covariance = taxel::pad_covariance<double>(n, 0.3e-3, 1e-3);
+    c.normal = n;
+    (on_top ? top : side).push_back(c);
+  }
+  std::vector<taxel::Contact<double>> all = top;
+  all.insert(all.end(), side.begin(), side.end());
+  const tf::Surfel<double> surfel;
+  const auto s = fuse_all(surfel, all);
+  const auto patch = fuse_all(surfel, top);
+  const auto k = fuse_all(tf::Kalman<double>(), side);
+  const double plane = tf::Kalman<double>().mean(k).x();
+  CAPTURE(surfel.mean(patch).x(), surfel.mean(s).x(), plane);
+  CHECK(s.xcount == 60.0);
+  CHECK(surfel.mean(patch).x() > plane + 0.5e-3);
+  CHECK(std::abs(surfel.mean(s).x() - plane) < 1e-12);
+  // Only the component along the side's normal moves.
+  CHECK(std::abs(surfel.mean(s).z() - surfel.mean(patch).z()) < 1e-12);
+}

@@ -54,6 +54,9 @@ namespace taxel::fusion {
 /// J^-1 ((J - J_x) d + eta_x), Kalman's tight planes meeting across the crease; fully at 80 %.
 /// (Fusing them at every share measured worse: on a box and a cone one face's lateral
 /// information is another's height information, and pulls a point on the crease inside.)
+/// With three or more apart contacts the point is, besides, kept from lying outside their
+/// plane (through their Kalman mean, along their mean normal): a point whose patch contacts
+/// scattered past a convex edge would otherwise sit on its face's plane beyond the edge.
 /// A crease shallower than `max_normal_angle` (or one a depth-map normal rounds) puts every
 /// contact in the patch, and the slopes jump across it where a quadric has them change
 /// linearly. Where the slopes' residual about the fitted H exceeds 9 times the variance the
@@ -72,7 +75,7 @@ namespace taxel::fusion {
 /// which does not depend on the state. P = J^-1 is formed when asked for (`covariance`), and
 /// in each update only with process noise or a gate. A covariance whose inverse overflows
 /// (a variance below about 1e-308 m^2) makes the point non-finite, and `ContactCloud` refuses
-/// the contact. State: 576 bytes (double). No allocation.
+/// the contact. State: 600 bytes (double). No allocation.
 template <Scalar S>
 struct Surfel {
   /// The floating-point type of positions and covariances (float or double).
@@ -128,9 +131,10 @@ struct Surfel {
     /// the patch (without a normal, or turned further than max_normal_angle), which the filter
     /// took unturned.
     S xinfo[6] = {};
-    Vec3<S> xeta = Vec3<S>::Zero();  ///< see xinfo
-    S xcount = S(0);                 ///< contacts apart from the patch
-    S sss[3] = {};                   ///< v-weighted sums of s_x^2, s_x s_y, s_y^2 [-]
+    Vec3<S> xeta = Vec3<S>::Zero();     ///< see xinfo
+    S xcount = S(0);                    ///< contacts apart from the patch
+    Vec3<S> xnormal = Vec3<S>::Zero();  ///< sum of their normals (of those that have one)
+    S sss[3] = {};                      ///< v-weighted sums of s_x^2, s_x s_y, s_y^2 [-]
     /// Information [1/m^2] and information vector [1/m] of every contact unturned: plain
     /// Kalman's, which the mean moves to where one smooth patch does not fit the slopes.
     S kinfo[6] = {};
@@ -211,7 +215,11 @@ struct Surfel {
     // A slope is tan of the normal's angle to n0: beyond max_normal_angle (from the mean normal
     // or from n0) it is no curvature datum but another face across an edge, or an outlier.
     const S nz = nc.dot(s.n0);
-    if (!(cos_c >= cos_max_) || !(nz >= cos_max_)) return filter_apart(s, d, ci);
+    if (!(cos_c >= cos_max_) || !(nz >= cos_max_)) {
+      if (!filter_apart(s, d, ci)) return false;
+      s.xnormal += nc;
+      return true;
+    }
     // Turn the information onto the mean normal: Q R^-1 Q' with Q = I + [v]x + [v]x^2 / (1 + c),
     // v = nc x nm, [v]x^2 = v v' - |v|^2 I written out; only the upper triangle is formed (it
     // is symmetric by construction).
@@ -279,6 +287,14 @@ struct Surfel {
       inverse(s.info, p);
       const S f = std::min((apart - kApartLow) / (kApartHigh - kApartLow), S(1));
       d += f * (times(p, times(ja, d) + s.xeta) - d);
+    }
+    if (s.xcount >= S(3) && s.xnormal.squaredNorm() > S(0)) {
+      // Not outside the other faces' plane: their Kalman mean m_x, their mean normal n_x.
+      S p[6];
+      inverse(s.xinfo, p);
+      const Vec3<S> nx = s.xnormal.normalized();
+      const S outside = nx.dot(d - times(p, s.xeta));
+      if (outside > S(0)) d -= outside * nx;
     }
     const S k = crease_share(s, h);
     if (k > S(0)) {
