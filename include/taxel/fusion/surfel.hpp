@@ -55,7 +55,8 @@ namespace taxel::fusion {
 /// (Fusing them at every share measured worse: on a box and a cone one face's lateral
 /// information is another's height information, and pulls a point on the crease inside.)
 /// With three or more apart contacts the point is, besides, kept from lying outside their
-/// plane (through their Kalman mean, along their mean normal): a point whose patch contacts
+/// plane: through their Kalman mean, along the mean of their normals that state no more noise
+/// than `normal_sigma` (a guessed normal defines no plane). A point whose patch contacts
 /// scattered past a convex edge would otherwise sit on its face's plane beyond the edge.
 /// A crease shallower than `max_normal_angle` (or one a depth-map normal rounds) puts every
 /// contact in the patch, and the slopes jump across it where a quadric has them change
@@ -131,10 +132,11 @@ struct Surfel {
     /// the patch (without a normal, or turned further than max_normal_angle), which the filter
     /// took unturned.
     S xinfo[6] = {};
-    Vec3<S> xeta = Vec3<S>::Zero();     ///< see xinfo
-    S xcount = S(0);                    ///< contacts apart from the patch
-    Vec3<S> xnormal = Vec3<S>::Zero();  ///< sum of their normals (of those that have one)
-    S sss[3] = {};                      ///< v-weighted sums of s_x^2, s_x s_y, s_y^2 [-]
+    Vec3<S> xeta = Vec3<S>::Zero();  ///< see xinfo
+    S xcount = S(0);                 ///< contacts apart from the patch
+    /// sum of their normals that state no more noise than normal_sigma
+    Vec3<S> xnormal = Vec3<S>::Zero();
+    S sss[3] = {};  ///< v-weighted sums of s_x^2, s_x s_y, s_y^2 [-]
     /// Information [1/m^2] and information vector [1/m] of every contact unturned: plain
     /// Kalman's, which the mean moves to where one smooth patch does not fit the slopes.
     S kinfo[6] = {};
@@ -217,7 +219,7 @@ struct Surfel {
     const S nz = nc.dot(s.n0);
     if (!(cos_c >= cos_max_) || !(nz >= cos_max_)) {
       if (!filter_apart(s, d, ci)) return false;
-      s.xnormal += nc;
+      if (!(c.normal_sigma > config_.normal_sigma)) s.xnormal += nc;  // a measured normal
       return true;
     }
     // Turn the information onto the mean normal: Q R^-1 Q' with Q = I + [v]x + [v]x^2 / (1 + c),
