@@ -56,7 +56,7 @@ namespace taxel::fusion {
 /// information is another's height information, and pulls a point on the crease inside.)
 /// With three or more apart contacts the point is, besides, kept from lying outside their
 /// plane: through their Kalman mean, along the mean of their normals that state no more noise
-/// than `normal_sigma` (a guessed normal defines no plane). A point whose patch contacts
+/// than twice `normal_sigma` (a guessed normal defines no plane). A point whose patch contacts
 /// scattered past a convex edge would otherwise sit on its face's plane beyond the edge.
 /// A crease shallower than `max_normal_angle` (or one a depth-map normal rounds) puts every
 /// contact in the patch, and the slopes jump across it where a quadric has them change
@@ -134,7 +134,7 @@ struct Surfel {
     S xinfo[6] = {};
     Vec3<S> xeta = Vec3<S>::Zero();  ///< see xinfo
     S xcount = S(0);                 ///< contacts apart from the patch
-    /// sum of their normals that state no more noise than normal_sigma
+    /// sum of their normals that state no more noise than twice normal_sigma
     Vec3<S> xnormal = Vec3<S>::Zero();
     S sss[3] = {};  ///< v-weighted sums of s_x^2, s_x s_y, s_y^2 [-]
     /// Information [1/m^2] and information vector [1/m] of every contact unturned: plain
@@ -219,7 +219,7 @@ struct Surfel {
     const S nz = nc.dot(s.n0);
     if (!(cos_c >= cos_max_) || !(nz >= cos_max_)) {
       if (!filter_apart(s, d, ci)) return false;
-      if (!(c.normal_sigma > config_.normal_sigma)) s.xnormal += nc;  // a measured normal
+      if (!(c.normal_sigma > S(2) * config_.normal_sigma)) s.xnormal += nc;  // measured
       return true;
     }
     // Turn the information onto the mean normal: Q R^-1 Q' with Q = I + [v]x + [v]x^2 / (1 + c),
