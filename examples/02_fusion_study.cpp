@@ -480,7 +480,7 @@ void robustness_matrix(bool quick, unsigned threads) {
   const std::size_t n = quick ? 20000 : 200000, n_short = n / 10;
   const int seeds = quick ? 1 : 3;
   const std::vector<MatrixCell> cells = matrix_cells();
-  const char* const shape_names[] = {"box",        "cylinder r30", "cone",  "ellipsoid",
+  const char* const shape_names[] = {"box",        "cylinder r30", "cone", "ellipsoid",
                                      "sphere r15", "sphere r40",   "torus"};
   constexpr std::size_t kShapes = 7;
   // Per job: average, kalman, surfel, surfel with lateral_scatter; then both Surfels at n / 10.
@@ -505,13 +505,27 @@ void robustness_matrix(bool quick, unsigned threads) {
       r.fit[5] = matrix_fit<tf::Surfel<double>>(sh, contacts, n_short, lateral);
     };
     switch (shape) {
-      case 0: run(sim::Box()); break;
-      case 1: run(sim::Cylinder(0.03, 0.05)); break;
-      case 2: run(sim::Cone()); break;
-      case 3: run(sim::Ellipsoid()); break;
-      case 4: run(sim::Sphere(0.015)); break;
-      case 5: run(sim::Sphere(0.04)); break;
-      default: run(sim::Torus()); break;
+      case 0:
+        run(sim::Box());
+        break;
+      case 1:
+        run(sim::Cylinder(0.03, 0.05));
+        break;
+      case 2:
+        run(sim::Cone());
+        break;
+      case 3:
+        run(sim::Ellipsoid());
+        break;
+      case 4:
+        run(sim::Sphere(0.015));
+        break;
+      case 5:
+        run(sim::Sphere(0.04));
+        break;
+      default:
+        run(sim::Torus());
+        break;
     }
   });
   std::printf(
@@ -567,9 +581,9 @@ void robustness_matrix(bool quick, unsigned threads) {
   }
 }
 
+// A real tactel reports the indentation averaged over its footprint, not at its centre
+// (read_pad's footprint): the pad model with and without it, sliding on two spheres.
 void footprint_table(bool quick) {
-  // A real tactel reports the indentation averaged over its footprint, not at its centre
-  // (read_pad's footprint): the pad model with and without it, sliding on two spheres.
   std::printf(
       "\nThe pad model with footprint integration (a tactel reads its mean indentation, 2 x 2 "
       "Gauss points) against readings at the tactel centre; sliding, 4 x %d frames, 3.4 mm radius. "

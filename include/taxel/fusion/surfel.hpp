@@ -422,29 +422,24 @@ struct Surfel {
   //   update:               J += R^-1, eta += R^-1 (m - origin).
   // With q = 0 and no gate the update is two sums: no inverse of the state.
   bool filter(State& s, const Vec3<S>& d, const S ri[6]) const {
-    if (q2_ > S(0) || config_.kalman.gate_chi2) {
-      S p[6];
+    if (config_.kalman.gate_chi2) {
+      // Mahalanobis distance of the innovation under P- + R (R the covariance as fused:
+      // turned when ri is).
+      S p[6], r[6], sm[6], si[6];
       inverse(s.info, p);
-      const Vec3<S> mu = times(p, s.eta);
+      const Vec3<S> e = d - times(p, s.eta);
       p[0] += q2_;
       p[3] += q2_;
       p[5] += q2_;
-      if (config_.kalman.gate_chi2) {
-        // Mahalanobis distance of the innovation under P- + R (R the covariance as fused:
-        // turned when ri is).
-        S r[6], sm[6], si[6];
-        inverse(ri, r);
-        for (int i = 0; i < 6; ++i) sm[i] = p[i] + r[i];
-        inverse(sm, si);
-        const Vec3<S> e = d - mu;
-        if (e.dot(times(si, e)) > *config_.kalman.gate_chi2) return false;
-      }
-      if (q2_ > S(0)) {
-        inverse(p, s.info);
-        s.eta = times(s.info, mu);
-        if (s.xcount > S(0)) predict(s.xinfo, s.xeta);
-        predict(s.kinfo, s.keta);
-      }
+      inverse(ri, r);
+      for (int i = 0; i < 6; ++i) sm[i] = p[i] + r[i];
+      inverse(sm, si);
+      if (e.dot(times(si, e)) > *config_.kalman.gate_chi2) return false;
+    }
+    if (q2_ > S(0)) {
+      predict(s.info, s.eta);
+      if (s.xcount > S(0)) predict(s.xinfo, s.xeta);
+      predict(s.kinfo, s.keta);
     }
     for (int i = 0; i < 6; ++i) s.info[i] += ri[i];
     s.eta += times(ri, d);
