@@ -474,7 +474,8 @@ std::vector<MatrixCell> matrix_cells() {
 }
 
 // The robustness matrix (sim::contact_stream): every cell on seven shapes and `seeds` seeds,
-// averaging, Kalman, Surfel and Surfel with lateral_scatter. Prints a row per shape and seed,
+// averaging, Kalman, Surfel, and Surfel told that the lateral covariance is a footprint (the
+// contacts' footprint_sigma set to it: no lift removed). Prints a row per shape and seed,
 // and per cell the worst ratios and signed errors.
 void robustness_matrix(bool quick, unsigned threads) {
   const std::size_t n = quick ? 20000 : 200000, n_short = n / 10;
@@ -483,7 +484,7 @@ void robustness_matrix(bool quick, unsigned threads) {
   const char* const shape_names[] = {"box",        "cylinder r30", "cone", "ellipsoid",
                                      "sphere r15", "sphere r40",   "torus"};
   constexpr std::size_t kShapes = 7;
-  // Per job: average, kalman, surfel, surfel with lateral_scatter; then both Surfels at n / 10.
+  // Per job: average, kalman, surfel, surfel with the footprint; then both Surfels at n / 10.
   struct Job {
     MatrixFit fit[6];
   };
@@ -495,14 +496,15 @@ void robustness_matrix(bool quick, unsigned threads) {
     cfg.seed = 1000 + j % seeds;
     const auto run = [&](const auto& sh) {
       const auto contacts = sim::contact_stream(sh, cfg);
-      const tf::Surfel<double>::Config lateral{.lateral_scatter = true};
+      auto footprint = contacts;
+      for (auto& c : footprint) c.footprint_sigma = cfg.sigma_lateral;
       Job& r = results[j];
       r.fit[0] = matrix_fit<tf::Average<double>>(sh, contacts, n);
       r.fit[1] = matrix_fit<tf::Kalman<double>>(sh, contacts, n);
       r.fit[2] = matrix_fit<tf::Surfel<double>>(sh, contacts, n);
-      r.fit[3] = matrix_fit<tf::Surfel<double>>(sh, contacts, n, lateral);
+      r.fit[3] = matrix_fit<tf::Surfel<double>>(sh, footprint, n);
       r.fit[4] = matrix_fit<tf::Surfel<double>>(sh, contacts, n_short);
-      r.fit[5] = matrix_fit<tf::Surfel<double>>(sh, contacts, n_short, lateral);
+      r.fit[5] = matrix_fit<tf::Surfel<double>>(sh, footprint, n_short);
     };
     switch (shape) {
       case 0:
@@ -535,13 +537,14 @@ void robustness_matrix(bool quick, unsigned threads) {
       "sharp, turned by 0.05 rad per axis, not stated; pose error 0.2 mm and 0.02 rad per frame, "
       "not stated. Each other cell changes one factor, the last all adverse at once.\n"
       "RMS / signed error [mm], RMS over averaging's in brackets; crease: RMS of the points "
-      "within 4 mm of an edge, rim or apex; lateral: Surfel::Config::lateral_scatter.\n",
+      "within 4 mm of an edge, rim or apex; footprint: Surfel with the contacts' lateral sigma "
+      "stated as their footprint_sigma (no lift removed).\n",
       n);
   const bool smooth[kShapes] = {false, false, false, true, true, true, true};
   for (std::size_t cell = 0; cell < cells.size(); ++cell) {
     std::printf(
         "\n[%s]\nshape          seed  average          kalman                  surfel             "
-        "     surfel, lateral        | crease: kalman surfel lateral\n",
+        "     surfel, footprint      | crease: kalman surfel footprint\n",
         cells[cell].name);
     double worst_avg[2] = {0, 0}, worst_kal[2] = {0, 0}, worst_signed[2] = {0, 0},
            worst_rise[2] = {-1, -1};
@@ -575,27 +578,29 @@ void robustness_matrix(bool quick, unsigned threads) {
       std::printf(
           "%s: worst RMS over averaging's %.2f, over Kalman's %.2f; largest signed error on "
           "smooth shapes %+.3f mm; RMS from %zu to %zu contacts: largest rise %+.0f %%\n",
-          k == 0 ? "  surfel" : "  surfel, lateral", worst_avg[k], worst_kal[k],
+          k == 0 ? "  surfel" : "  surfel, footprint", worst_avg[k], worst_kal[k],
           1e3 * worst_signed[k], n_short, n, 100.0 * worst_rise[k]);
     }
   }
 }
 
 // A real tactel reports the indentation averaged over its footprint, not at its centre
-// (read_pad's footprint): the pad model with and without it, sliding on two spheres.
+// (read_pad's footprint): the pad model with and without it, and with readings-to-contacts
+// told so (ContactOptions::tactel_area), sliding on two spheres.
 void footprint_table(bool quick) {
   std::printf(
       "\nThe pad model with footprint integration (a tactel reads its mean indentation, 2 x 2 "
-      "Gauss points) against readings at the tactel centre; sliding, 4 x %d frames, 3.4 mm radius. "
-      "Raw contacts' signed error, then RMS / signed error [mm]:\n"
-      "shape       footprint seed  raw      average          kalman           surfel\n",
+      "Gauss points) against readings at the tactel centre, and with tactel_area; sliding, 4 x %d "
+      "frames, 3.4 mm radius. Raw contacts' signed error, then RMS / signed error [mm]:\n"
+      "shape       footprint  area seed  raw      average          kalman           surfel\n",
       quick ? 500 : 1500);
   for (const double R : {0.015, 0.04}) {
-    for (const int footprint : {1, 2}) {
+    for (const int variant : {0, 1, 2}) {
       for (const std::uint64_t seed : {11u, 12u}) {
         const sim::Sphere sphere(R);
         sim::ExplorationConfig cfg;
-        cfg.footprint = footprint;
+        cfg.footprint = variant == 0 ? 1 : 2;
+        cfg.contacts.tactel_area = variant == 2;
         cfg.seed = seed;
         const auto contacts =
             sim::explore_sliding(sphere, cfg, {.slides = 4, .frames = quick ? 500u : 1500u})
@@ -607,7 +612,8 @@ void footprint_table(bool quick) {
         const Row a = fuse<tf::Average<double>>(sphere, contacts, m, {}, 3.4e-3);
         const Row k = fuse<tf::Kalman<double>>(sphere, contacts, m, {}, 3.4e-3);
         const Row s = fuse<tf::Surfel<double>>(sphere, contacts, m, {}, 3.4e-3);
-        std::printf("sphere r%-3.0f %9d %4d  %+.3f", 1e3 * R, footprint, int(seed), 1e3 * raw);
+        std::printf("sphere r%-3.0f %9d %5s %4d  %+.3f", 1e3 * R, cfg.footprint,
+                    variant == 2 ? "yes" : "no", int(seed), 1e3 * raw);
         for (const Row* r : {&a, &k, &s}) {
           std::printf("   %.3f / %+.3f", 1e3 * r->m.error.rms, 1e3 * r->m.error.signed_mean);
         }

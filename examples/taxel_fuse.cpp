@@ -50,8 +50,11 @@ taxel-record --poses writes it, columns time_ms,matrix,...) or else the controll
 matrix poses.
 
 CONTACTS.csv has a header naming its columns
-(time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure, normal_sigma; x, y, z
-required; see include/taxel/io/contacts_csv.hpp); CLOUD.ply gets the fused points with their
+(time, x, y, z, cxx, cxy, cxz, cyy, cyz, czz, nx, ny, nz, pressure, normal_sigma,
+footprint_sigma; x, y, z required; see include/taxel/io/contacts_csv.hpp). The covariance
+across the normal is scatter of the position (surfel removes the lift it gives on a curved
+surface) except for footprint_sigma^2, a tactel's footprint around a point on the surface
+(contacts from readings state pitch / sqrt(12)). CLOUD.ply gets the fused points with their
 normals (surfel) and the properties "observations", the covariance "cov_xx", "cov_xy",
 "cov_xz", "cov_yy", "cov_yz", "cov_zz" [m^2] and "last_time". Units: metres and seconds.
 
@@ -67,10 +70,6 @@ options:
                     noise tail cannot start a point off the surface (default 6; 0: off)
   --gate CHI2       surfel, kalman: Mahalanobis gate (e.g. 11.345 for 99 %; default none)
   --process-noise Q surfel, kalman: process noise [m] per update (default 0)
-  --lateral-scatter surfel: the contacts' covariance across the normal is real scatter of
-                    their positions along the tangent plane (streams from kinematics or
-                    cameras), which lifts them off a curved surface; remove that lift
-                    (default: a footprint, as taxel's readings-to-contacts model states it)
   --min-observations N   keep only points with at least N contacts (default 1: all)
   --max-sigma S     keep only points whose largest standard deviation is at most S [m]
   --max-normal-sigma S  keep only points whose smallest standard deviation (across the
@@ -85,6 +84,9 @@ readings (--readings, --session):
   --per-pad         one contact per pad and frame (default: one per active tactel; a frame
                     with under six active tactels, or whose depths the frame's quadric does
                     not fit, gives one per tactel)
+  --tactel-area     a reading is the mean indentation over the tactel's area (a real
+                    tactel), not at its centre: move each depth to the centre's where the
+                    frame's quadric fits (default: readings at the centres)
   --pitch P         tactel pitch [m] (default 0.0034; --readings only)
   --levels L        reading levels, e.g. 4096 for 12 bits (default 4096; --readings only)
   --full-scale-depth D   indentation at the largest reading [m] (default 0.003)
@@ -116,10 +118,10 @@ struct Options {
   double process_noise = 0.0;
   bool ascii = false;
   bool strict = false;
-  bool lateral_scatter = false;
   std::uint32_t min_observations = 1;
   std::string readings, poses, session;
   bool per_pad = false;
+  bool tactel_area = false;
   double frame_rate = 1000.0;
   taxel::sensor::SensorModel model;
   double max_sigma = std::numeric_limits<double>::infinity();
@@ -345,8 +347,6 @@ int main(int argc, char** argv) {
       o.max_normal_sigma = args.length(0.0, kInf);
     } else if (a == "--strict") {
       o.strict = true;
-    } else if (a == "--lateral-scatter") {
-      o.lateral_scatter = true;
     } else if (a == "--ascii") {
       o.ascii = true;
     } else if (a == "--scale") {
@@ -359,6 +359,8 @@ int main(int argc, char** argv) {
       o.session = std::string(args.value());
     } else if (a == "--per-pad") {
       o.per_pad = true;
+    } else if (a == "--tactel-area") {
+      o.tactel_area = true;
     } else if (a == "--pitch") {
       o.model.geometry.pitch = args.length(1e-6, 1.0);  // SensorModel's ranges, checked here
                                                         // before any input is read
@@ -396,8 +398,6 @@ int main(int argc, char** argv) {
         "--scale applies to CONTACTS.csv; the readings' geometry is set in metres by "
         "--pitch and --full-scale-depth");
   }
-  if (o.lateral_scatter && o.policy != "surfel")
-    args.fail("--lateral-scatter goes with --policy surfel");
   if (!from_readings && !from_session && !o.poses.empty()) {
     args.fail("--poses goes with --readings or --session");
   }
@@ -414,6 +414,7 @@ int main(int argc, char** argv) {
   taxel::sensor::ContactOptions copt;
   copt.mode =
       o.per_pad ? taxel::sensor::ContactMode::per_pad : taxel::sensor::ContactMode::per_tactel;
+  copt.tactel_area = o.tactel_area;
   std::string shortfall;  // a session replay that ended early: the output is kept, exit 1
   // Readings and sessions become contacts in memory (a stack of readings is itself held
   // whole); a CSV is read a batch at a time.
@@ -496,8 +497,7 @@ int main(int argc, char** argv) {
     } else if (o.policy == "kalman") {
       code = with_index<tf::Kalman<double>>(o, kc, feed, args);
     } else {
-      code = with_index<tf::Surfel<double>>(o, {.kalman = kc, .lateral_scatter = o.lateral_scatter},
-                                            feed, args);
+      code = with_index<tf::Surfel<double>>(o, {.kalman = kc}, feed, args);
     }
     return code == 0 && !shortfall.empty() ? 1 : code;
   } catch (const std::invalid_argument& e) {  // a configuration the cloud refuses

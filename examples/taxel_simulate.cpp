@@ -52,6 +52,8 @@ options:
                      0: exactly the exploration below)
   --footprint N      where a tactel senses: 1 at its centre (default); 2-4 the mean indentation
                      over its area (N x N points), as a real tactel averages
+  --tactel-area      contacts from readings taken as means over the tactels' areas (see
+                     taxel-fuse --help; pair with --footprint 2 or more)
   --per-pad          one contact per pad and frame (a quadric fitted to its depth map; one per
                      tactel when under six are active or the quadric does not fit them), not
                      one per tactel
@@ -258,6 +260,8 @@ int main(int argc, char** argv) {
         args.fail("--exploration must be sliding, grasp or palpation");
     } else if (a == "--contacts") {
       o.contacts = args.number<std::size_t>(0, std::size_t{1} << 26);
+    } else if (a == "--tactel-area") {
+      o.config.contacts.tactel_area = true;
     } else if (a == "--per-pad") {
       o.config.contacts.mode = ts::ContactMode::per_pad;
     } else if (a == "--footprint") {

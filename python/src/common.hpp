@@ -319,6 +319,7 @@ struct ContactRows {
   std::optional<ArrayD> pressures;    // (N,)
   std::optional<ArrayD> times;        // (N,)
   Mat3d default_covariance = Contact<double>{}.covariance;
+  double footprint_sigma = 0.0;  // every row's Contact::footprint_sigma
 
   /// Contact `i`. Safe without the GIL: only reads the arrays' buffers.
   Contact<double> at(std::size_t i) const {
@@ -339,6 +340,7 @@ struct ContactRows {
     }
     if (pressures) c.pressure = pressures->data()[i];
     if (times) c.time = times->data()[i];
+    c.footprint_sigma = footprint_sigma;
     return c;
   }
 };
@@ -346,6 +348,7 @@ struct ContactRows {
 /// Checks the arrays' shapes against each other; throws ValueError naming the one that differs.
 ContactRows contact_rows(ArrayD positions, std::optional<ArrayD> covariances,
                          std::optional<ArrayD> normals, std::optional<ArrayD> pressures,
-                         std::optional<ArrayD> times, std::optional<double> sigma);
+                         std::optional<ArrayD> times, std::optional<double> sigma,
+                         double footprint_sigma);
 
 }  // namespace taxel::python

@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: MIT
 // taxel.PointCloud and taxel.Contacts: the containers the other modules pass around.
+#include <cmath>
+#include <string>
+
 #include "common.hpp"
 
 namespace taxel::python {
@@ -19,8 +22,13 @@ Cloud cloud_from(const ArrayD& points, const std::optional<ArrayD>& normals, con
 
 ContactRows contact_rows(ArrayD positions, std::optional<ArrayD> covariances,
                          std::optional<ArrayD> normals, std::optional<ArrayD> pressures,
-                         std::optional<ArrayD> times, std::optional<double> sigma) {
+                         std::optional<ArrayD> times, std::optional<double> sigma,
+                         double footprint_sigma) {
   require_shape(positions, {-1, 3}, "positions", "(N, 3)");
+  if (!(footprint_sigma >= 0) || !std::isfinite(footprint_sigma)) {
+    throw py::value_error("footprint_sigma must be finite and >= 0 [m], got " +
+                          std::to_string(footprint_sigma));
+  }
   ContactRows r;
   r.n = static_cast<std::size_t>(positions.shape(0));
   const auto n = static_cast<py::ssize_t>(r.n);
@@ -45,6 +53,7 @@ ContactRows contact_rows(ArrayD positions, std::optional<ArrayD> covariances,
   r.normals = std::move(normals);
   r.pressures = std::move(pressures);
   r.times = std::move(times);
+  r.footprint_sigma = footprint_sigma;
   return r;
 }
 
@@ -124,10 +133,11 @@ Made from arrays, or returned by the readers, the simulator and
 the C++ loop with no conversion.)doc")
       .def(py::init([](ArrayD positions, std::optional<ArrayD> covariances,
                        std::optional<ArrayD> normals, std::optional<ArrayD> pressures,
-                       std::optional<ArrayD> times, std::optional<double> sigma) {
+                       std::optional<ArrayD> times, std::optional<double> sigma,
+                       double footprint_sigma) {
              const ContactRows rows =
                  contact_rows(std::move(positions), std::move(covariances), std::move(normals),
-                              std::move(pressures), std::move(times), sigma);
+                              std::move(pressures), std::move(times), sigma, footprint_sigma);
              ContactList out(rows.n);
              for (std::size_t i = 0; i < rows.n; ++i) out[i] = rows.at(i);
              return out;
@@ -135,8 +145,12 @@ the C++ loop with no conversion.)doc")
            py::arg("positions"), py::arg("covariances") = py::none(),
            py::arg("normals") = py::none(), py::arg("pressures") = py::none(),
            py::arg("times") = py::none(), py::arg("sigma") = py::none(),
+           py::arg("footprint_sigma") = 0.0,
            "Contacts from (N, 3) positions; covariances (N, 3, 3) or one (3, 3) for all, or an "
-           "isotropic `sigma` [m]; the default is 1 mm isotropic.")
+           "isotropic `sigma` [m]; the default is 1 mm isotropic. `footprint_sigma` [m]: how "
+           "much of the covariance across the normal is a footprint around a point on the "
+           "surface rather than scatter of the position (0: all scatter; a tactel of pitch p "
+           "read at its centre: p / sqrt(12)).")
       .def("__len__", &ContactList::size)
       .def_property_readonly(
           "positions",
@@ -170,6 +184,8 @@ the C++ loop with no conversion.)doc")
       .def_property_readonly(
           "normal_sigmas", &contact_column<&Contact<double>::normal_sigma>,
           "(N,) angular standard deviations of the normals [rad]; 0 where not stated")
+      .def_property_readonly("footprint_sigmas", &contact_column<&Contact<double>::footprint_sigma>,
+                             "(N,) footprints across the normals [m]; 0: all scatter")
       .def("__repr__",
            [](const ContactList& cs) { return "Contacts(" + std::to_string(cs.size()) + ")"; });
 }

@@ -327,26 +327,30 @@ fewer than six active, or whose depths the quadric does not fit); `local_normals
 (remove the bias of readings that barely passed the noise floor); `fallback_normal_sigma`
 [rad], the slope uncertainty where the depth map cannot measure it; `refine_censoring` (evaluate
 that correction at the depth a quadric fitted to the pad predicts, unbiased at the rim of a
-contact; False: at the reading itself, about half the cost).)doc")
+contact; False: at the reading itself, about half the cost); `tactel_area` (a reading is the
+mean indentation over the tactel's area, as a real tactel's is: each depth is moved to the
+centre's where the frame's quadric fits).)doc")
       .def(py::init([](const std::string& mode, bool local_normals, bool correct_censoring,
-                       double fallback_normal_sigma, bool refine_censoring) {
+                       double fallback_normal_sigma, bool refine_censoring, bool tactel_area) {
              sensor::ContactOptions o;
              o.mode = enum_from(mode, kModes, "mode");
              o.local_normals = local_normals;
              o.correct_censoring = correct_censoring;
              o.fallback_normal_sigma = fallback_normal_sigma;
              o.refine_censoring = refine_censoring;
+             o.tactel_area = tactel_area;
              o.validate();
              return o;
            }),
            py::arg("mode") = "per_tactel", py::arg("local_normals") = true,
            py::arg("correct_censoring") = true, py::arg("fallback_normal_sigma") = 0.15,
-           py::arg("refine_censoring") = true)
+           py::arg("refine_censoring") = true, py::arg("tactel_area") = false)
       .def_property_readonly(
           "mode", [](const sensor::ContactOptions& o) { return enum_name(o.mode, kModes); })
       .def_readonly("local_normals", &sensor::ContactOptions::local_normals)
       .def_readonly("correct_censoring", &sensor::ContactOptions::correct_censoring)
       .def_readonly("refine_censoring", &sensor::ContactOptions::refine_censoring)
+      .def_readonly("tactel_area", &sensor::ContactOptions::tactel_area)
       .def_readonly("fallback_normal_sigma", &sensor::ContactOptions::fallback_normal_sigma);
 
   s.def("contacts_from_readings", &readings_to_contacts, py::arg("readings"), py::arg("poses"),
@@ -427,10 +431,11 @@ Options that the chosen policy or index does not use must stay at their defaults
           "insert",
           [](PyContactCloud& c, ArrayD positions, std::optional<ArrayD> covariances,
              std::optional<ArrayD> normals, std::optional<ArrayD> pressures,
-             std::optional<ArrayD> times, std::optional<double> sigma, bool strict) {
+             std::optional<ArrayD> times, std::optional<double> sigma, double footprint_sigma,
+             bool strict) {
             const ContactRows rows =
                 contact_rows(std::move(positions), std::move(covariances), std::move(normals),
-                             std::move(pressures), std::move(times), sigma);
+                             std::move(pressures), std::move(times), sigma, footprint_sigma);
             BatchResult r;
             {
               py::gil_scoped_release release;
@@ -445,11 +450,14 @@ Options that the chosen policy or index does not use must stay at their defaults
           py::arg("positions"), py::arg("covariances") = py::none(),
           py::arg("normals") = py::none(), py::arg("pressures") = py::none(),
           py::arg("times") = py::none(), py::kw_only(), py::arg("sigma") = py::none(),
-          py::arg("strict") = true,
+          py::arg("footprint_sigma") = 0.0, py::arg("strict") = true,
           R"doc(
 Inserts contacts in row order: positions (N, 3) [m]; covariances (N, 3, 3) or one (3, 3)
 [m^2], or an isotropic `sigma` [m] (default 1 mm); normals (N, 3) unit vectors, a NaN row for
-none; pressures (N,); times (N,) [s]. C-contiguous float64 arrays are read in place.
+none; pressures (N,); times (N,) [s]. `footprint_sigma` [m]: how much of the covariance across
+the normal is a footprint around a point on the surface, not scatter (0: all scatter, whose
+lift off a curved surface the surfel policy removes). C-contiguous float64 arrays are read in
+place.
 With strict (default) an invalid contact raises ValueError and nothing is inserted; with
 strict=False invalid contacts are skipped and counted. Returns {'added', 'fused', 'rejected'}.)doc")
       .def(

@@ -23,8 +23,10 @@ fewer than six active, or whose depths the quadric does not fit); `local_normals
 (remove the bias of readings that barely passed the noise floor); `fallback_normal_sigma`
 [rad], the slope uncertainty where the depth map cannot measure it; `refine_censoring` (evaluate
 that correction at the depth a quadric fitted to the pad predicts, unbiased at the rim of a
-contact; False: at the reading itself, about half the cost)."""
-    def __init__(self, mode: str = 'per_tactel', local_normals: bool = True, correct_censoring: bool = True, fallback_normal_sigma: float = 0.15, refine_censoring: bool = True) -> None: ...
+contact; False: at the reading itself, about half the cost); `tactel_area` (a reading is the
+mean indentation over the tactel's area, as a real tactel's is: each depth is moved to the
+centre's where the frame's quadric fits)."""
+    def __init__(self, mode: str = 'per_tactel', local_normals: bool = True, correct_censoring: bool = True, fallback_normal_sigma: float = 0.15, refine_censoring: bool = True, tactel_area: bool = False) -> None: ...
     @property
     def correct_censoring(self) -> bool: ...
     @property
@@ -35,6 +37,8 @@ contact; False: at the reading itself, about half the cost)."""
     def mode(self) -> str: ...
     @property
     def refine_censoring(self) -> bool: ...
+    @property
+    def tactel_area(self) -> bool: ...
 
 
 class SensorModel:

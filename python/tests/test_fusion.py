@@ -252,6 +252,54 @@ def test_refined_and_plug_in_censoring_corrections():
     assert np.any(refined != want)
 
 
+def test_footprints_stated_by_readings_and_arrays():
+    # Contacts from readings state a tactel's footprint, pitch / sqrt(12); contacts from arrays
+    # state none unless told, and a bad footprint is refused before anything is made.
+    readings = np.full((1, 1, 14, 6), 1000, dtype=np.uint16)
+    poses = np.eye(4).reshape(1, 1, 4, 4)
+    pad = sensor.contacts_from_readings(readings, poses)
+    np.testing.assert_allclose(pad.footprint_sigmas, 3.4e-3 / np.sqrt(12), rtol=1e-12)
+    assert sensor.ContactOptions(tactel_area=True).tactel_area
+    assert not sensor.ContactOptions().tactel_area
+    assert np.all(taxel.Contacts(np.zeros((3, 3))).footprint_sigmas == 0)
+    stated = taxel.Contacts(np.zeros((3, 3)), sigma=1e-3, footprint_sigma=5e-4)
+    assert np.all(stated.footprint_sigmas == 5e-4)
+    for bad in (-1e-3, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="footprint_sigma"):
+            taxel.Contacts(np.zeros((3, 3)), footprint_sigma=bad)
+        with pytest.raises(ValueError, match="footprint_sigma"):
+            fusion.ContactCloud().insert(np.zeros((3, 3)), footprint_sigma=bad)
+
+
+def test_surfel_removes_the_lift_of_scatter_not_of_a_footprint():
+    # A 15 mm sphere's surface points scattered 1 mm along the tangent plane, kept where their
+    # reported position lies within 2 mm of the top (as a point's gate keeps them): stated as
+    # scatter, the surfel policy removes their lift (sigma^2 / R = 0.067 mm); stated as a
+    # footprint, it does not.
+    rng = np.random.default_rng(4)
+    R, st, sn, n = 0.015, 1e-3, 0.3e-3, 200000
+    xy = rng.uniform(-6e-3, 6e-3, (n, 2))
+    true = np.column_stack([xy, np.sqrt(R * R - (xy ** 2).sum(axis=1))])
+    normals = true / R
+    t1 = np.cross(normals, [1.0, 0.0, 0.0])
+    t1 /= np.linalg.norm(t1, axis=1)[:, None]
+    t2 = np.cross(normals, t1)
+    g = rng.standard_normal((n, 3))
+    reported = true + st * (g[:, :1] * t1 + g[:, 1:2] * t2) + sn * g[:, 2:] * normals
+    keep = np.hypot(reported[:, 0], reported[:, 1]) < 2e-3
+    reported, normals = reported[keep], normals[keep]
+    cov = st * st * np.eye(3) + (sn * sn - st * st) * np.einsum("ni,nj->nij", normals, normals)
+    heights = []
+    for footprint in (0.0, st):
+        cloud = fusion.ContactCloud(association_radius=0.02)  # one point for all
+        cloud.insert(reported, cov, normals, footprint_sigma=footprint)
+        assert len(cloud) == 1
+        heights.append(np.linalg.norm(cloud.means[0]) - R)
+    assert heights[1] - heights[0] == pytest.approx(st * st / R, rel=0.1)
+    assert heights[1] > 0.5 * st * st / R
+    assert abs(heights[0]) < 0.35 * st * st / R
+
+
 def test_truncation_bias_closed_form():
     # At the threshold, the bias of a surviving reading is sigma * phi(0) / (1 - Phi(0)).
     assert sensor.truncation_bias(1e-3, 1e-3, 3e-4) == pytest.approx(3e-4 * np.sqrt(2 / np.pi))

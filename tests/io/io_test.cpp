@@ -488,6 +488,7 @@ TEST_CASE("Contacts CSV: round trip, foreign layouts, strict errors", "[io][csv]
   contacts[0].normal = taxel::Vec3d(0, 0, 1);
   contacts[0].pressure = 1234.5;
   contacts[0].normal_sigma = 0.0625;
+  contacts[0].footprint_sigma = 9.8e-4;
   contacts[1].position = {1.0 / 3.0, 2e-9, -7.25};
   contacts[2].position = {0, 0, 0};
   contacts[2].normal = taxel::Vec3d(0.6, 0.8, 0);
@@ -500,12 +501,18 @@ TEST_CASE("Contacts CSV: round trip, foreign layouts, strict errors", "[io][csv]
     CHECK(back[i].time == contacts[i].time);
     CHECK(back[i].pressure == contacts[i].pressure);
     CHECK(back[i].normal_sigma == contacts[i].normal_sigma);
+    CHECK(back[i].footprint_sigma == contacts[i].footprint_sigma);
   }
   // A normal's sigma may be left empty (not stated, 0), as for a contact without a normal.
   const auto sigmas = tio::parse_contacts_csv("x,y,z,normal_sigma\n1,2,3,\n4,5,6,0.2\n");
   REQUIRE(sigmas.size() == 2);
   CHECK(sigmas[0].normal_sigma == 0.0);
   CHECK(sigmas[1].normal_sigma == 0.2);
+  // So may a footprint (0: the lateral covariance is scatter).
+  const auto feet = tio::parse_contacts_csv("x,y,z,footprint_sigma\n1,2,3,\n4,5,6,1e-3\n");
+  REQUIRE(feet.size() == 2);
+  CHECK(feet[0].footprint_sigma == 0.0);
+  CHECK(feet[1].footprint_sigma == 1e-3);
   // Only positions, reordered columns, comments, CRLF, blank lines.
   const auto minimal = tio::parse_contacts_csv("# exported\r\nz, x ,y\r\n\r\n3,1,2\r\n6,4,5\r\n");
   REQUIRE(minimal.size() == 2);

@@ -29,6 +29,13 @@ struct Contact {
   /// that a fusion policy uses its own (`fusion::Surfel::Config::normal_sigma`). A normal the
   /// sensor could not measure (a lone tactel: the pad's own normal) states a large one.
   S normal_sigma = S(0);
+  /// How much of the covariance across the normal is the contact's footprint rather than
+  /// scatter: a standard deviation [m], >= 0. A footprint is where on the surface the contact
+  /// stands for, around a position that lies on the surface (a tactel of pitch p read at its
+  /// centre: p / sqrt(12), `tactel_sigma`). Scatter is how far the reported position strayed
+  /// along the tangent plane (a pose error, a camera's or a kinematic model's noise), which
+  /// lifts a contact off a curved surface. 0 (the default): all of it is scatter.
+  S footprint_sigma = S(0);
 };
 
 /// Standard deviation [m] of a uniform quantisation over one tactel of the given pitch [m]:
@@ -82,6 +89,7 @@ enum class ContactDefect {
   non_finite_pressure,    ///< pressure is NaN or Inf
   out_of_range,           ///< position beyond what the cloud's index separates exactly
   bad_normal_sigma,       ///< normal_sigma is negative, NaN or Inf
+  bad_footprint_sigma,    ///< footprint_sigma is negative, NaN or Inf
 };
 
 /// Short description of a contact defect.
@@ -109,6 +117,8 @@ constexpr std::string_view to_string(ContactDefect d) noexcept {
       return "position is beyond the index's range";
     case ContactDefect::bad_normal_sigma:
       return "normal_sigma is not finite and >= 0";
+    case ContactDefect::bad_footprint_sigma:
+      return "footprint_sigma is not finite and >= 0";
   }
   return "unknown";
 }
@@ -154,6 +164,9 @@ ContactDefect check_contact(const Contact<S>& c) noexcept {
   if (!(c.normal_sigma >= S(0)) || !std::isfinite(c.normal_sigma)) {
     return ContactDefect::bad_normal_sigma;
   }
+  if (!(c.footprint_sigma >= S(0)) || !std::isfinite(c.footprint_sigma)) {
+    return ContactDefect::bad_footprint_sigma;
+  }
   if (!std::isfinite(c.time)) return ContactDefect::non_finite_time;
   if (!std::isfinite(c.pressure)) return ContactDefect::non_finite_pressure;
   return ContactDefect::ok;
@@ -169,6 +182,7 @@ Contact<T> contact_cast(const Contact<S>& c) {
   out.pressure = static_cast<T>(c.pressure);
   out.time = c.time;
   out.normal_sigma = static_cast<T>(c.normal_sigma);
+  out.footprint_sigma = static_cast<T>(c.footprint_sigma);
   return out;
 }
 

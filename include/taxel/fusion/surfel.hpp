@@ -68,7 +68,13 @@ namespace taxel::fusion {
 /// result is `Kalman`'s, up to rounding.
 /// The offsets are measured positions: their own noise is not removed from M (the contacts
 /// a point gathers are those whose noisy positions fall near it, a Berkson error model, so
-/// an errors-in-variables correction would overcorrect).
+/// an errors-in-variables correction would overcorrect). A contact's position may itself have
+/// strayed along the tangent plane (a pose error, a camera's noise): such scatter lifts it off
+/// a curved surface by u'Hu / 2, tr(H Sigma_t) / 2 on average (sigma_t^2 / R on a sphere),
+/// and the mean subtracts that lift for the scatter the contacts state, which is their
+/// covariance across the normal less their footprint (`Contact::footprint_sigma`). A footprint
+/// (a tactel read at its centre) is where on the surface a contact stands for; its position
+/// lies on the surface and is not lifted.
 ///
 /// The filter is `Kalman`'s (same `Config::kalman`: process noise, gate, P0) kept in
 /// information form, J = P^-1 and eta = J (mu - origin): without process noise or gate an
@@ -89,14 +95,6 @@ struct Surfel {
     S normal_sigma = S(0.05);  ///< noise of a contact normal [rad], in [1e-6, pi]
     /// Prior standard deviation of the curvature [1/m], in [1e-6, 1e9].
     S curvature_prior = S(100);
-    /// What a contact's covariance across its normal says. false: where on the surface the
-    /// contact stands for, around a position that lies on the surface (a tactel's footprint in
-    /// taxel's readings-to-contacts model). true: how far the reported position scattered
-    /// along the surface's tangent plane from the true contact point, as in streams from a
-    /// kinematic model or a camera. Such scatter lifts a contact off a curved surface by
-    /// u'Hu / 2, tr(H Sigma_t) / 2 on average (sigma_t^2 / R on a sphere), which the point then
-    /// removes.
-    bool lateral_scatter = false;
   };
   /// A fused point: the filter in information form, its tangent frame and the curvature sums.
   /// Every member starts at zero (Eigen's vectors would otherwise start uninitialised, even in
@@ -125,8 +123,8 @@ struct Surfel {
     S ss[2] = {};      ///< v-weighted sum of s [-]
     S vuu[3] = {};     ///< v-weighted sums of u_x^2, u_x u_y, u_y^2 [m^2]
     S ssu[4] = {};     ///< v-weighted sums of s_x u_x, s_x u_y, s_y u_x, s_y u_y [m]
-    /// w-weighted sums of the stated covariance across the normal in the frame (xx, xy, yy)
-    /// [m^2] (Config::lateral_scatter only).
+    /// w-weighted sums of the stated scatter across the normal in the frame (xx, xy, yy)
+    /// [m^2]: the covariance there less the footprint (`Contact::footprint_sigma`).
     S scov[3] = {};
     /// Information J_x [1/m^2] and information vector eta_x [1/m] of the contacts apart from
     /// the patch (without a normal, or turned further than max_normal_angle), which the filter
@@ -271,10 +269,9 @@ struct Surfel {
     // slope over one standard deviation of the offsets stays below 45 degrees); beyond that the
     // fit is noise, not a surface.
     S sag = S(0.5) * (h[0] * cxx + S(2) * h[1] * cxy + h[2] * cyy);
-    if (config_.lateral_scatter) {
-      // Less the lift of the tangent-plane scatter, tr(H Sigma_t) / 2 (Config::lateral_scatter).
-      sag -= S(0.5) * inv * (h[0] * s.scov[0] + S(2) * h[1] * s.scov[1] + h[2] * s.scov[2]);
-    }
+    // Less the lift of the stated tangent-plane scatter, tr(H Sigma_t) / 2 (see the class
+    // comment).
+    sag -= S(0.5) * inv * (h[0] * s.scov[0] + S(2) * h[1] * s.scov[1] + h[2] * s.scov[2]);
     const S bound2 = S(0.25) * std::max(cxx + cyy, S(0));
     if (!(sag * sag <= bound2)) sag = std::copysign(std::sqrt(bound2), sag);  // rare: no sqrt
     const S z = s.sz * inv + sag;
@@ -408,13 +405,20 @@ struct Surfel {
     add_sums(s, w, share(c), s.t1.dot(d), s.t2.dot(d), s.n0.dot(d), S(0), S(0));
     add_scatter(s, w, c);
   }
-  // The stated covariance across the normal, in the frame (Config::lateral_scatter).
+  // The stated scatter across the normal, in the frame: the covariance there less the
+  // footprint's f^2 I, which is at most its smallest eigenvalue (a footprint stated wider than
+  // the covariance leaves no scatter along that axis rather than a negative one).
   void add_scatter(State& s, S w, const Contact<S>& c) const {
-    if (!config_.lateral_scatter) return;
     const Vec3<S> c1 = c.covariance * s.t1, c2 = c.covariance * s.t2;
-    s.scov[0] += w * s.t1.dot(c1);
-    s.scov[1] += w * s.t1.dot(c2);
-    s.scov[2] += w * s.t2.dot(c2);
+    const S a = s.t1.dot(c1), b = s.t1.dot(c2), d = s.t2.dot(c2);
+    S f2 = c.footprint_sigma * c.footprint_sigma;
+    if (f2 > std::min(a, d) - std::abs(b)) {  // beyond the Gershgorin bound: the eigenvalue
+      const S half = S(0.5) * (a - d);
+      f2 = std::min(f2, std::max(S(0.5) * (a + d) - std::sqrt(half * half + b * b), S(0)));
+    }
+    s.scov[0] += w * (a - f2);
+    s.scov[1] += w * b;
+    s.scov[2] += w * (d - f2);
   }
   // The filter's update with the information ri = R^-1 (upper triangle) of a contact at
   // offset d = m - origin: a Kalman filter with identity models in information form,

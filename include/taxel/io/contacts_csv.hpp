@@ -11,6 +11,9 @@
 //   pressure                      pressure [Pa] or raw sensor units    optional (default 0)
 //   normal_sigma                  angular standard deviation of the    optional (default 0: not
 //                                 normal [rad] (Contact::normal_sigma)  stated); empty cell: 0
+//   footprint_sigma               the footprint part of the covariance  optional (default 0: all
+//                                 across the normal [m]                 scatter); empty cell: 0
+//                                 (Contact::footprint_sigma)
 // Lines starting with '#' and blank lines are skipped; LF, CRLF and lone-CR line endings and a
 // leading UTF-8 byte-order mark are accepted. By default the reader is strict: unknown or
 // repeated columns, missing values, malformed numbers and a non-finite position, time or
@@ -38,9 +41,9 @@
 namespace taxel::io {
 
 /// Column names in the order encode_contacts_csv writes them.
-inline constexpr std::array<std::string_view, 15> kContactColumns{
-    "time", "x",   "y",  "z",  "cxx", "cxy",      "cxz",         "cyy",
-    "cyz",  "czz", "nx", "ny", "nz",  "pressure", "normal_sigma"};
+inline constexpr std::array<std::string_view, 16> kContactColumns{
+    "time", "x",   "y",  "z",  "cxx", "cxy",      "cxz",          "cyy",
+    "cyz",  "czz", "nx", "ny", "nz",  "pressure", "normal_sigma", "footprint_sigma"};
 
 /// Largest number of contacts parse_contacts_csv and read_contacts_csv return (2^26); the
 /// streaming ContactsCsvReader has no limit.
@@ -205,6 +208,7 @@ class ContactsCsvParser {
     }
     if (where_[13] >= 0) ct.pressure = finite(13);
     if (where_[14] >= 0) ct.normal_sigma = value(14, true).value_or(0.0);
+    if (where_[15] >= 0) ct.footprint_sigma = value(15, true).value_or(0.0);
   }
 
   std::string source_;
@@ -327,6 +331,8 @@ inline std::string encode_contacts_csv(const std::vector<Contact<double>>& conta
     put(c.pressure);
     out.push_back(',');
     put(c.normal_sigma);
+    out.push_back(',');
+    put(c.footprint_sigma);
     out.push_back('\n');
   }
   return out;

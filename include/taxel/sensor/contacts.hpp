@@ -51,7 +51,9 @@
 //     pad's kinematic tilt turns the normal as well: an angle sigma_tilt about a uniform axis
 //     tilts it by 2/3 sigma_tilt^2 in mean square, which is added to the slope variances. The
 //     contact states the square root of that sum as its normal's uncertainty (normal_sigma).
-//  3. Covariance. Tight along that normal, wide across it:
+//  3. Covariance. Tight along that normal, wide across it (the pitch^2 / 12 across is where
+//     on the surface the contact stands for, stated as its footprint, Contact::footprint_sigma;
+//     the pose's terms are scatter):
 //       across:  s_t^2 = pitch^2 / 12 + sigma_position^2 + |xy|^2 sigma_tilt^2 / 6
 //       along:   s_n^2 = var d + sigma_position^2
 //                        + |xy|^2 sigma_tilt^2 / 3 + (pitch^2 / 12) normal_sigma^2
@@ -68,6 +70,19 @@
 //     is about 0.4 % of the variance along the normal.
 //  4. Position. The tactel centre pushed back by the corrected depth along the pad normal:
 //     T_world_pad * (x, y, -d).
+//  5. Footprint (ContactOptions::tactel_area). A real tactel reads the mean compression over
+//     its area. Over a square of side p, a quadric compression q has the mean
+//     q(centre) + p^2 / 24 (q_xx + q_yy): a fully touching tactel on a convex surface of radius
+//     R reads p^2 / (12 R) less than at its centre (0.024 mm at R = 40 mm, p = 3.4 mm), and its
+//     contact sits inside. A tactel at the rim of the touch reads the mean of max(q, 0), the
+//     touching part's, deeper than its centre's (which may not touch at all), and its contact
+//     sits outside. So the quadric of step 1 is fitted to the readings, its constant moved by
+//     -(q_xx + q_yy) p^2 / 24 to describe the centres, and each tactel's expected reading f is
+//     the mean of max(q, 0) over its square (the closed form where q is positive at the four
+//     corners, otherwise 4 x 4 Gauss-Legendre points). The censoring correction is evaluated at
+//     that f, and the depth is moved by q(centre) - f. Both passes of step 1 do this, so the
+//     refit and the normals describe the centres. Frames without that quadric (too few active
+//     tactels, no noise, or an edge) keep their readings as they are.
 // Per pad, one contact per frame: a quadric d(x, y) = a + g . u + u' H u / 2 (u the offset from
 // the centroid of the active tactels) is fitted to their corrected depths, and the contact is
 // the fitted surface point above the centroid, with the fitted normal there and the fit's own
@@ -109,6 +124,12 @@ struct ContactOptions {
   /// Evaluate that correction at the depth a pad-wide quadric predicts rather than at the
   /// reading (unbiased at the rim of a contact; about twice the cost per active tactel).
   bool refine_censoring = true;
+  /// A reading is the mean compression over the tactel's pitch x pitch square, as a real
+  /// tactel's is (`sim::read_pad` with a footprint of 2 or more), not the compression at its
+  /// centre. Where the refined correction fits its quadric, each depth is moved to the centre's
+  /// by the footprint excess of that quadric (the model above, step 5); elsewhere the reading
+  /// is taken as it is.
+  bool tactel_area = false;
   /// Angular standard deviation [rad] of a normal slope that the depth map cannot measure
   /// (too few active neighbours, or every slope without local_normals); > 0.
   double fallback_normal_sigma = 0.15;
@@ -305,13 +326,15 @@ class ContactExtractor {
   }
 
   // The noise terms every contact of a frame shares (see the model above, step 3), read once
-  // per frame: sigma_position^2, sigma_tilt^2 / 6 and / 3, and pitch^2 / 12.
+  // per frame: sigma_position^2, sigma_tilt^2 / 6 and / 3, pitch^2 / 12 and its square root
+  // (the footprint a contact states).
   struct SharedNoise {
-    double sp2, st2_6, st2_3, q2;
+    double sp2, st2_6, st2_3, q2, footprint;
   };
   SharedNoise shared_noise() const {
     const double st2 = model_.sigma_tilt * model_.sigma_tilt;
-    return {model_.sigma_position * model_.sigma_position, st2 / 6.0, st2 / 3.0, q2()};
+    return {model_.sigma_position * model_.sigma_position, st2 / 6.0, st2 / 3.0, q2(),
+            tactel_sigma(model_.geometry.pitch)};
   }
 
   // The contact at pad point (x, y, -depth) with outward normal n_pad (pad frame), extra
@@ -340,8 +363,8 @@ class ContactExtractor {
     Mat3d cov;
     cov << vt + dv * n.x() * n.x(), cxy, cxz, cxy, vt + dv * n.y() * n.y(), cyz, cxz, cyz,
         vt + dv * n.z() * n.z();
-    out.push_back(
-        Contact<double>{T * Vec3d(x, y, -depth), cov, n, pressure, time, std::sqrt(slope_var)});
+    out.push_back(Contact<double>{T * Vec3d(x, y, -depth), cov, n, pressure, time,
+                                  std::sqrt(slope_var), sn.footprint});
   }
 
   template <class = void>
@@ -374,7 +397,7 @@ class ContactExtractor {
         gx = (q[1] + 2 * q[3] * x + q[4] * y) * inv_p;
         gy = (q[2] + q[4] * x + 2 * q[5] * y) * inv_p;
         vg = f[0] + x * (f[1] + f[3] * x + f[4] * y) + y * (f[2] + f[5] * y);
-        depth = refined(cens, e, fitted(q, e)).depth;
+        depth = centre_depth(cens, q, e);
       } else if (options_.local_normals) {
         // Least-squares plane over the active 3x3 neighbourhood: linear in the depths, with
         // weights that depend only on which neighbours are active (plane_weights).
@@ -433,6 +456,35 @@ class ContactExtractor {
   static double fitted(const double* q, const Active& e) {
     return q[0] + e.x * (q[1] + q[3] * e.x + q[4] * e.y) + e.y * (q[2] + q[5] * e.y);
   }
+  // The mean of max(q, 0) over the unit square (pitch units) about an active tactel, whose
+  // centre's value is c (the model above, step 5).
+  static double footprint_mean(const double* q, const Active& e, double c) {
+    const double gx = q[1] + 2 * q[3] * e.x + q[4] * e.y, gy = q[2] + q[4] * e.x + 2 * q[5] * e.y;
+    const double mid = c + 0.25 * (q[3] + q[5]);  // the corners' mean less their slopes' share
+    if (std::min({mid + 0.5 * (gx + gy) + 0.25 * q[4], mid + 0.5 * (gx - gy) - 0.25 * q[4],
+                  mid + 0.5 * (gy - gx) - 0.25 * q[4], mid - 0.5 * (gx + gy) + 0.25 * q[4]}) > 0) {
+      return c + (q[3] + q[5]) / 12.0;
+    }
+    double sum = 0;
+    for (int i = 0; i < 4; ++i) {
+      const double v = kGaussNode[3][i];
+      for (int j = 0; j < 4; ++j) {
+        const double u = kGaussNode[3][j];
+        const double at = c + u * (gx + q[3] * u + q[4] * v) + v * (gy + q[5] * v);
+        sum += kGaussWeight[3][i] * kGaussWeight[3][j] * std::max(at, 0.0);
+      }
+    }
+    return sum;
+  }
+  // An active tactel's corrected depth at its centre, for the quadric q of the centres' depths:
+  // the censoring correction at its expected reading, and with tactel_area the footprint
+  // excess of q removed (the model above, steps 1 and 5).
+  double centre_depth(const Censoring& cens, const double* q, const Active& e) const {
+    const double c = fitted(q, e);
+    if (!options_.tactel_area) return refined(cens, e, c).depth;
+    const double f = footprint_mean(q, e, c);
+    return refined(cens, e, f).depth - (f - c);
+  }
 
   // The refined censoring correction (the model above, step 1): quadric fit of the plug-in
   // depths, the correction evaluated at the fitted depth with its Jensen term, refitted once.
@@ -459,9 +511,12 @@ class ContactExtractor {
     // variance: the truncated normal's, sigma^2 (1 - lambda'), plus the fit's share through
     // the correction's slope lambda'.
     const Censoring cens = censoring();
-    const auto correct = [&](Active& e, double f, bool with_variance) {
+    const bool area = options_.tactel_area;
+    const auto correct = [&](Active& e, const double* q, bool with_variance) {
+      const double c = fitted(q, e);
+      const double f = area ? footprint_mean(q, e, c) : c;
       const Refined r = refined(cens, e, f);
-      padded_[e.at] = r.depth;
+      padded_[e.at] = r.depth - (f - c);
       if (with_variance) {
         const double l1 = r.lambda * (r.lambda - r.a);
         e.var = vd * (1.0 - l1) + l1 * l1 * e.jensen * 2.0 * sigma;
@@ -490,6 +545,11 @@ class ContactExtractor {
                             bb(5, 5),
                             0.0};
     const Eigen::Map<const Eigen::Array<double, 16, 1>> lev_map(lev);
+    // With tactel_area the fit describes the readings; the centres' quadric has the same
+    // curvature (the model above, step 5).
+    double centres[6];
+    std::copy_n(sol, 6, centres);
+    if (area) centres[0] -= (sol[3] + sol[5]) / 12.0;
     // Pass 0: leverages, residuals, corrections at the first fit, pass 1's right-hand side.
     double rss = 0;
     Vec6 sum1 = Vec6::Zero();
@@ -501,7 +561,7 @@ class ContactExtractor {
       const double f = fitted(sol, e);
       const double res = padded_[e.at] - f;
       rss += res * res;
-      correct(e, f, false);
+      correct(e, centres, false);
       const double d = padded_[e.at];
       sum1 += Eigen::Map<const Vec6>(row) * d;
     }
@@ -529,7 +589,7 @@ class ContactExtractor {
       // step 1.)
       const bool variances = options_.mode == ContactMode::per_pad;
       for (std::size_t i = 0; i < count; ++i) {
-        correct(active_[i], fitted(sol1, active_[i]), variances);
+        correct(active_[i], sol1, variances);
       }
       return;
     }

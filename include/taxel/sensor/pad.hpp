@@ -70,6 +70,21 @@ struct SensorModel {
   }
 };
 
+/// Gauss-Legendre nodes on [-1/2, 1/2] for 1 to 4 points (row n - 1), and their weights
+/// (summing to 1): a tactel's footprint (its pitch x pitch square) is integrated
+/// on them, n per side.
+inline constexpr double kGaussNode[4][4] = {
+    {0.0},
+    {-0.28867513459481287, 0.28867513459481287},
+    {-0.3872983346207417, 0.0, 0.3872983346207417},
+    {-0.43056815579702629, -0.16999052179242813, 0.16999052179242813, 0.43056815579702629}};
+/// See kGaussNode.
+inline constexpr double kGaussWeight[4][4] = {
+    {1.0},
+    {0.5, 0.5},
+    {0.2777777777777778, 0.4444444444444444, 0.2777777777777778},
+    {0.17392742256872692, 0.32607257743127307, 0.32607257743127307, 0.17392742256872692}};
+
 /// Readings of one pad as a row-major rows x cols matrix of counts.
 using PadMatrix = Eigen::Array<std::uint16_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 

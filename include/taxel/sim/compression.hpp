@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "taxel/core/types.hpp"
+#include "taxel/sensor/pad.hpp"
 #include "taxel/sim/shapes.hpp"
 
 namespace taxel::sim {
@@ -24,18 +25,9 @@ double compression(const Sh& shape, const Vec3d& at, const Vec3d& back) {
   return t;
 }
 
-/// Gauss-Legendre nodes on [-1/2, 1/2] for 1 to 4 points (row n - 1), and their weights
-/// (summing to 1): a tactel's footprint is integrated on them, n per side.
-inline constexpr double kGaussNode[4][4] = {
-    {0.0},
-    {-0.28867513459481287, 0.28867513459481287},
-    {-0.3872983346207417, 0.0, 0.3872983346207417},
-    {-0.43056815579702629, -0.16999052179242813, 0.16999052179242813, 0.43056815579702629}};
-/// See kGaussNode.
-inline constexpr double kGaussWeight[4][4] = {
-    {1.0},
-    {0.5, 0.5},
-    {0.2777777777777778, 0.4444444444444444, 0.2777777777777778},
-    {0.17392742256872692, 0.32607257743127307, 0.32607257743127307, 0.17392742256872692}};
+// The footprint quadrature lives with the pad (sensor/pad.hpp); the simulators use it by these
+// names.
+using sensor::kGaussNode;
+using sensor::kGaussWeight;
 
 }  // namespace taxel::sim
