@@ -8,6 +8,7 @@
 #include "taxel/index.hpp"
 #include "taxel/io.hpp"
 #include "taxel/learn.hpp"
+#include "taxel/optical.hpp"
 #include "taxel/registration.hpp"
 #include "taxel/sensor.hpp"
 #include "taxel/sim.hpp"

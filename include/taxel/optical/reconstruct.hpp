@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: MIT
+// A frame to a height map and contacts: the colour change against the calibration's
+// background, the calibrated map to gradients, the contact mask (colour change beyond the
+// threshold, holes filled, grown by `grow` pixels), gradients set to zero outside it (the
+// untouched gel is flat; this keeps the integration's drift out of the contact), and the
+// Poisson integration (poisson.hpp, free border: a contact may reach the frame's edge) to
+// heights in metres, positive into the gel, the untouched pixels averaging zero.
+// Contacts, in the sensor frame: x along the frame's columns and y along its rows, from the
+// frame's centre, z = -height (the sensing face looks along +z, into the touched object, as a
+// pad's does), the normal -(gx, gy, 1) / |(gx, gy, 1)|. Every `stride`-th pixel of the mask in
+// each direction gives one, standing for a stride x stride footprint.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "taxel/core/contact.hpp"
+#include "taxel/optical/calibration.hpp"
+#include "taxel/optical/poisson.hpp"
+
+namespace taxel::optical {
+
+/// What a frame shows.
+struct HeightMap {
+  Plane height;      ///< [m], positive into the gel; the untouched gel averages 0
+  Plane gx;          ///< d height / dx, along columns (0 outside the mask)
+  Plane gy;          ///< d height / dy, along rows (0 outside the mask)
+  image::Mask mask;  ///< 1 where the gel is touched
+};
+
+/// A frame's height map (see the header comment). `grow`: pixels added around the mask, >= 0.
+/// Throws std::invalid_argument for a frame of another size than the calibration's or a
+/// solver of another size.
+template <class = void>
+HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolver& solver,
+                      int grow = 2) {
+  frame.validate("reconstruct");
+  if (frame.rows != cal.rows || frame.cols != cal.cols) {
+    throw std::invalid_argument("reconstruct: the frame is " + std::to_string(frame.rows) + " x " +
+                                std::to_string(frame.cols) + ", the calibration is for " +
+                                std::to_string(cal.rows) + " x " + std::to_string(cal.cols));
+  }
+  if (solver.rows() != cal.rows || solver.cols() != cal.cols) {
+    throw std::invalid_argument("reconstruct: the solver is for another frame size");
+  }
+  if (grow < 0) throw std::invalid_argument("reconstruct: grow must be >= 0");
+  const Colour change = colour_change(frame, cal.background);
+  // A frame far darker than the background (the lights off, the lens covered) or far brighter
+  // (saturated) shows no gel: refused rather than read as a press over the whole frame.
+  const double level = (change[0].mean() + change[1].mean() + change[2].mean()) / 3.0;
+  const double base =
+      (cal.background[0].mean() + cal.background[1].mean() + cal.background[2].mean()) / 3.0;
+  if (!(std::abs(level) <= 0.5 * base)) {
+    throw std::invalid_argument(
+        "reconstruct: the frame's mean level differs from the "
+        "background's (" +
+        std::to_string(base) + ") by " + std::to_string(level) +
+        ": no gel in view (lights off, lens covered or saturated)?");
+  }
+  HeightMap out;
+  out.mask = contact_mask(change, cal.threshold);
+  image::Mask grown = out.mask;
+  for (int g = 0; g < grow; ++g) {
+    const image::Mask m = grown;
+    for (int r = 0; r < cal.rows; ++r) {
+      for (int c = 0; c < cal.cols; ++c) {
+        if (m(r, c)) continue;
+        if ((r > 0 && m(r - 1, c)) || (r + 1 < cal.rows && m(r + 1, c)) || (c > 0 && m(r, c - 1)) ||
+            (c + 1 < cal.cols && m(r, c + 1))) {
+          grown(r, c) = 1;
+        }
+      }
+    }
+  }
+  out.gx = Plane::Zero(cal.rows, cal.cols);
+  out.gy = Plane::Zero(cal.rows, cal.cols);
+  for (int r = 0; r < cal.rows; ++r) {
+    for (int c = 0; c < cal.cols; ++c) {
+      if (!grown(r, c)) continue;
+      cal.gradient(change[0](r, c), change[1](r, c), change[2](r, c), r, c, out.gx(r, c),
+                   out.gy(r, c));
+    }
+  }
+  const image::Mask untouched = (grown == 0).cast<std::uint8_t>();
+  out.height = solver.integrate(out.gx, out.gy, cal.pixel, PoissonBorder::free, untouched);
+  return out;
+}
+
+/// Contacts of a height map (see the header comment), in the world through `T_world_sensor`,
+/// at `time` [s]. Each states `sigma_height` [m] along its normal and its footprint across it
+/// (stride pixels wide), and `normal_sigma` [rad] as its normal's uncertainty. Appends to `out`
+/// and returns the number appended. Throws std::invalid_argument for a stride < 1 or sigmas
+/// not finite and > 0.
+template <class = void>
+std::size_t height_contacts(const HeightMap& map, double pixel,
+                            const Eigen::Isometry3d& T_world_sensor, double time,
+                            double sigma_height, double normal_sigma, int stride,
+                            std::vector<Contact<double>>& out) {
+  if (stride < 1) throw std::invalid_argument("height_contacts: stride must be >= 1");
+  if (!(sigma_height > 0) || !std::isfinite(sigma_height) || !(normal_sigma > 0) ||
+      !std::isfinite(normal_sigma) || !(pixel > 0) || !std::isfinite(pixel)) {
+    throw std::invalid_argument(
+        "height_contacts: pixel, sigma_height and normal_sigma must be "
+        "finite and > 0");
+  }
+  const Eigen::Index rows = map.height.rows(), cols = map.height.cols();
+  const double footprint = stride * pixel / std::sqrt(12.0);
+  std::size_t added = 0;
+  for (Eigen::Index r = stride / 2; r < rows; r += stride) {
+    for (Eigen::Index c = stride / 2; c < cols; c += stride) {
+      if (!map.mask(r, c)) continue;
+      const Vec3d local((double(c) - 0.5 * double(cols - 1)) * pixel,
+                        (double(r) - 0.5 * double(rows - 1)) * pixel, -map.height(r, c));
+      const Vec3d n_local = -Vec3d(map.gx(r, c), map.gy(r, c), 1.0).normalized();
+      Contact<double> ct;
+      ct.position = T_world_sensor * local;
+      const Vec3d n = T_world_sensor.linear() * n_local;
+      ct.normal = n;
+      ct.covariance = pad_covariance<double>(n, sigma_height, footprint);
+      ct.footprint_sigma = footprint;
+      ct.normal_sigma = normal_sigma;
+      ct.time = time;
+      ct.pressure = map.height(r, c);
+      out.push_back(ct);
+      ++added;
+    }
+  }
+  return added;
+}
+
+/// A sphere fitted to a height map inside its contact: the algebraic least-squares sphere
+/// through the surface points (x, y, -height) of the mask's pixels whose height is at least
+/// `min_share` of the largest (the contact's flat fringe would pull it towards a plane).
+struct BallFit {
+  double radius = 0;       ///< [m]
+  double cx = 0;           ///< centre above this column [px]
+  double cy = 0;           ///< centre above this row [px]
+  std::size_t points = 0;  ///< pixels used
+};
+
+/// See BallFit. Throws std::runtime_error when fewer than 10 pixels qualify.
+template <class = void>
+BallFit fit_ball(const HeightMap& map, double pixel, double min_share = 0.1) {
+  const double peak = map.height.maxCoeff();
+  const Eigen::Index rows = map.height.rows(), cols = map.height.cols();
+  double ox = 0, oy = 0;
+  std::size_t n = 0;
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      if (!map.mask(r, c) || !(map.height(r, c) >= min_share * peak) || !(peak > 0)) continue;
+      ox += double(c);
+      oy += double(r);
+      ++n;
+    }
+  }
+  if (n < 10) throw std::runtime_error("fit_ball: fewer than 10 pixels of the contact");
+  ox /= double(n);
+  oy /= double(n);
+  // x^2 + y^2 + z^2 + D x + E y + F z + G = 0, about the pixels' centroid.
+  Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d b = Eigen::Vector4d::Zero();
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      if (!map.mask(r, c) || !(map.height(r, c) >= min_share * peak)) continue;
+      const double x = (double(c) - ox) * pixel, y = (double(r) - oy) * pixel;
+      const double z = -map.height(r, c);
+      const Eigen::Vector4d v(x, y, z, 1.0);
+      A += v * v.transpose();
+      b -= v * (x * x + y * y + z * z);
+    }
+  }
+  const Eigen::Vector4d s = A.ldlt().solve(b);
+  BallFit fit;
+  fit.radius = std::sqrt(std::max(0.25 * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) - s[3], 0.0));
+  fit.cx = ox - 0.5 * s[0] / pixel;
+  fit.cy = oy - 0.5 * s[1] / pixel;
+  fit.points = n;
+  return fit;
+}
+
+}  // namespace taxel::optical

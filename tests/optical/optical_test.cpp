@@ -1,0 +1,268 @@
+// SPDX-License-Identifier: MIT
+// Tests of the optical layer: the transforms against their direct sums, Poisson integration
+// against exact heights, contact circles, and a calibration on rendered ball presses that
+// reconstructs held-out presses of a ball, a cylinder and an edge against the rendering's truth.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <taxel/optical.hpp>
+#include <taxel/sim/optical.hpp>
+#include <vector>
+
+namespace to = taxel::optical;
+namespace ts = taxel::sim;
+
+namespace {
+
+constexpr int kRows = 240, kCols = 320;
+constexpr double kPixel = 0.0634e-3;  // a GelSight Mini's mm per pixel, in metres
+constexpr double kBall = 2e-3;        // calibration ball radius [m]
+
+to::Plane random_plane(int rows, int cols, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  to::Plane p(rows, cols);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) p(r, c) = u(rng);
+  }
+  return p;
+}
+
+// A rendered set-up: the model's background, ball presses and a calibration from them.
+struct Rig {
+  to::ShadingModel model;
+  to::Colour background;
+  to::RgbFrame background_frame;
+  std::vector<to::RgbFrame> presses;
+  std::vector<to::Circle> truth;
+  std::mt19937_64 rng{7};
+
+  explicit Rig(int presses_count) {
+    background = to::render_background(model, kRows, kCols);
+    const to::Plane zero = to::Plane::Zero(kRows, kCols);
+    background_frame = to::render(zero, zero, background, model, 2.0, rng);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int i = 0; i < presses_count; ++i) {
+      const double d = 0.3e-3 + 0.4e-3 * u(rng), cx = 40 + 240 * u(rng), cy = 40 + 160 * u(rng);
+      presses.push_back(frame(ts::press_ball(kRows, kCols, kPixel, kBall, d, cx, cy)));
+      truth.push_back({cx, cy, std::sqrt(kBall * kBall - (kBall - d) * (kBall - d)) / kPixel});
+    }
+  }
+  to::RgbFrame frame(const ts::GelPress& g) {
+    return to::render(g.gx, g.gy, background, model, 2.0, rng);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("optical: the DST-I and DCT-II by FFT equal their direct sums", "[optical]") {
+  std::mt19937_64 rng(1);
+  for (const auto& [rows, cols] : {std::pair{7, 9}, std::pair{6, 8}, std::pair{3, 3}}) {
+    to::PoissonSolver solver(rows, cols);
+    const to::Plane a = random_plane(rows, cols, rng);
+    to::Plane dst = a, dct = a, back = a;
+    solver.dst_rows(dst);
+    solver.dct_rows(dct);
+    solver.dct_cols(back);
+    solver.idct_cols(back);
+    const double pi = std::numbers::pi;
+    for (int r = 0; r < rows; ++r) {
+      for (int k = 0; k < cols; ++k) {
+        double s = 0, c = 0;
+        for (int j = 0; j < cols; ++j) {
+          s += a(r, j) * std::sin(pi * (j + 1) * (k + 1) / (cols + 1));
+          c += a(r, j) * std::cos(pi * k * (2 * j + 1) / (2.0 * cols));
+        }
+        CHECK(dst(r, k) == Approx(s).margin(1e-12));
+        CHECK(dct(r, k) == Approx(c).margin(1e-12));
+        CHECK(back(r, k) == Approx(a(r, k)).margin(1e-12));
+      }
+    }
+  }
+}
+
+TEST_CASE("optical: Poisson integration recovers heights from their exact gradients", "[optical]") {
+  // A Gaussian bump, 0.4 mm high and 12 px wide, inside a 120 x 160 frame, and a tilted
+  // plane's ramp that runs off the frame: the free border recovers both (up to the constant
+  // it sets on the untouched pixels); the zero border only the bump, which vanishes there.
+  const int rows = 120, cols = 160;
+  const double pixel = 0.05e-3, amp = 0.4e-3, w = 12.0;
+  to::Plane h(rows, cols), gx(rows, cols), gy(rows, cols);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const double x = c - 80.0, y = r - 60.0;
+      const double e = amp * std::exp(-(x * x + y * y) / (2 * w * w));
+      h(r, c) = e;
+      gx(r, c) = -x / (w * w) * e / pixel;
+      gy(r, c) = -y / (w * w) * e / pixel;
+    }
+  }
+  to::PoissonSolver solver(rows, cols);
+  const to::Plane zero_border = solver.integrate(gx, gy, pixel, to::PoissonBorder::zero);
+  const to::Plane free_border = solver.integrate(gx, gy, pixel);
+  // (Free: the whole frame averages 0, so compare after removing the mean.)
+  const double mean = h.mean();
+  CHECK((zero_border - h).abs().maxCoeff() < 0.01 * amp);
+  CHECK((free_border - (h - mean)).abs().maxCoeff() < 0.01 * amp);
+  // A ramp along x, 0.2 mm over the frame, plus the bump: the free border keeps it.
+  to::Plane gr = gx + 0.2e-3 / (cols * pixel);
+  to::Plane ramp(rows, cols);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) ramp(r, c) = h(r, c) + 0.2e-3 * c / cols;
+  }
+  const to::Plane free_ramp = solver.integrate(gr, gy, pixel);
+  CHECK((free_ramp - (ramp - ramp.mean())).abs().maxCoeff() < 0.01 * amp);
+  CHECK_THROWS_WITH(solver.integrate(to::Plane::Zero(3, 3), gy, pixel),
+                    Catch::Contains("gx is 3 x 3, the solver's planes are 120 x 160"));
+  CHECK_THROWS_WITH(solver.integrate(gx, gy, 0.0), Catch::Contains("pixel size"));
+  CHECK_THROWS_WITH(to::PoissonSolver(2, 5), Catch::Contains("at least 3 x 3"));
+}
+
+TEST_CASE("optical: a ball press's contact circle is found to a fifth of a pixel", "[optical]") {
+  Rig rig(6);
+  for (std::size_t i = 0; i < rig.presses.size(); ++i) {
+    const to::Colour change = to::colour_change(rig.presses[i], rig.background);
+    const to::Circle c = to::find_contact_circle(change);
+    CAPTURE(i, c.cx, c.cy, c.radius, rig.truth[i].radius);
+    CHECK(std::abs(c.cx - rig.truth[i].cx) < 0.2);
+    CHECK(std::abs(c.cy - rig.truth[i].cy) < 0.2);
+    CHECK(std::abs(c.radius - rig.truth[i].radius) < 0.2);
+  }
+  // No contact: the background frame itself.
+  CHECK_THROWS_WITH(
+      to::find_contact_circle(to::colour_change(rig.background_frame, rig.background)),
+      Catch::Contains("no contact"));
+}
+
+TEST_CASE(
+    "optical: a calibration from rendered presses reconstructs a ball, a cylinder and an "
+    "edge",
+    "[optical]") {
+  Rig rig(12);
+  const to::Calibration cal =
+      to::calibrate(rig.presses, rig.background_frame, {.ball_radius = kBall, .pixel = kPixel});
+  REQUIRE(cal.circles.size() == 12);
+  // Held-out gradient errors of both maps, and the better one kept.
+  CAPTURE(cal.heldout_polynomial, cal.heldout_table);
+  CHECK(cal.heldout() == std::min(cal.heldout_polynomial, cal.heldout_table));
+  CHECK(cal.heldout() < 0.08);
+  to::PoissonSolver solver(kRows, kCols);
+  // Held-out balls (not among the presses): radius from the fitted sphere, height against the
+  // truth inside the contact.
+  for (const double cx : {90.0, 160.0, 250.0}) {
+    const ts::GelPress g = ts::press_ball(kRows, kCols, kPixel, kBall, 0.5e-3, cx, 120.0);
+    const to::HeightMap map = to::reconstruct(rig.frame(g), cal, solver);
+    const to::BallFit fit = to::fit_ball(map, kPixel);
+    double e = 0, n = 0;
+    for (int r = 0; r < kRows; ++r) {
+      for (int c = 0; c < kCols; ++c) {
+        if (g.height(r, c) <= 0) continue;
+        e += (map.height(r, c) - g.height(r, c)) * (map.height(r, c) - g.height(r, c));
+        n += 1;
+      }
+    }
+    CAPTURE(cx, fit.radius, std::sqrt(e / n));
+    CHECK(std::abs(fit.radius - kBall) < 0.1 * kBall);  // measured: 3-5 % small
+    CHECK(std::abs(fit.cx - cx) < 1.0);
+    CHECK(std::sqrt(e / n) < 0.03e-3);  // measured: 0.008-0.014 mm
+    CHECK(map.height.maxCoeff() == Approx(0.5e-3).epsilon(0.06));
+  }
+  // A cylinder across the whole frame (its contact reaches the border) and an edge.
+  for (const bool edge : {false, true}) {
+    const ts::GelPress g =
+        edge ? ts::press_edge(kRows, kCols, kPixel, 0.4, 0.3e-3, 160, 120, 0.3)
+             : ts::press_cylinder(kRows, kCols, kPixel, 3e-3, 0.4e-3, 160, 120, 0.5);
+    const to::HeightMap map = to::reconstruct(rig.frame(g), cal, solver);
+    double e = 0, n = 0, outside = 0, m = 0;
+    for (int r = 0; r < kRows; ++r) {
+      for (int c = 0; c < kCols; ++c) {
+        const double d = map.height(r, c) - g.height(r, c);
+        if (g.height(r, c) > 0) {
+          e += d * d;
+          n += 1;
+        } else {
+          outside += d * d;
+          m += 1;
+        }
+      }
+    }
+    CAPTURE(edge, std::sqrt(e / n), std::sqrt(outside / m));
+    CHECK(std::sqrt(e / n) < (edge ? 0.02e-3 : 0.04e-3));  // measured 0.010 and 0.024 mm
+    CHECK(std::sqrt(outside / m) < 0.015e-3);
+  }
+}
+
+TEST_CASE("optical: contacts of a height map lie on the pressed surface in the world",
+          "[optical]") {
+  Rig rig(8);
+  const to::Calibration cal =
+      to::calibrate(rig.presses, rig.background_frame, {.ball_radius = kBall, .pixel = kPixel});
+  to::PoissonSolver solver(kRows, kCols);
+  const ts::GelPress g = ts::press_ball(kRows, kCols, kPixel, kBall, 0.5e-3, 160, 120);
+  const to::HeightMap map = to::reconstruct(rig.frame(g), cal, solver);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = taxel::Vec3d(0.1, -0.2, 0.3);
+  pose.linear() = Eigen::AngleAxisd(0.7, taxel::Vec3d(1, 2, 3).normalized()).toRotationMatrix();
+  std::vector<taxel::Contact<double>> contacts;
+  const std::size_t n = to::height_contacts(map, kPixel, pose, 1.5, 0.02e-3, 0.05, 4, contacts);
+  REQUIRE(n == contacts.size());
+  REQUIRE(n > 50);
+  // The ball's centre in the sensor frame: above pixel (160, 120) at z = R - d (the sensing
+  // face looks along +z, into the ball).
+  const taxel::Vec3d centre =
+      pose * taxel::Vec3d((160 - 0.5 * (kCols - 1)) * kPixel, (120 - 0.5 * (kRows - 1)) * kPixel,
+                          kBall - 0.5e-3);
+  double worst = 0, worst_normal = 0;
+  for (const auto& c : contacts) {
+    CHECK(taxel::check_contact(c) == taxel::ContactDefect::ok);
+    CHECK(c.time == 1.5);
+    const double dist = (c.position - centre).norm() - kBall;
+    // Outside the contact circle (the mask's fringe), the point is on the flat gel.
+    if ((c.position - centre).norm() > kBall + 0.05e-3) continue;
+    worst = std::max(worst, std::abs(dist));
+    worst_normal = std::max(
+        worst_normal, std::acos(std::min(1.0, -c.normal->dot((centre - c.position).normalized()))));
+  }
+  CHECK(worst < 0.06e-3);
+  CHECK(worst_normal < 0.25);
+  CHECK_THROWS_WITH(to::height_contacts(map, kPixel, pose, 0, 0.02e-3, 0.05, 0, contacts),
+                    Catch::Contains("stride"));
+}
+
+TEST_CASE("optical: bad frames, presses and options are refused with the reason", "[optical]") {
+  Rig rig(4);
+  const to::CalibrationOptions o{.ball_radius = kBall, .pixel = kPixel};
+  // A press of another size.
+  std::vector<to::RgbFrame> mixed = rig.presses;
+  mixed[2] = to::RgbFrame::zeros(120, 160);
+  CHECK_THROWS_WITH(to::calibrate(mixed, rig.background_frame, o),
+                    Catch::Contains("press 2 is 120 x 160, the background 240 x 320"));
+  // A press with no contact.
+  std::vector<to::RgbFrame> blank = rig.presses;
+  blank[1] = rig.background_frame;
+  CHECK_THROWS_WITH(to::calibrate(blank, rig.background_frame, o),
+                    Catch::Contains("press 1: find_contact_circle: no contact"));
+  // A ball radius given in millimetres: the circles are wider than the "ball".
+  CHECK_THROWS_WITH(
+      to::calibrate(rig.presses, rig.background_frame, {.ball_radius = 2e-6, .pixel = kPixel}),
+      Catch::Contains("wider than the ball"));
+  CHECK_THROWS_WITH(to::calibrate({rig.presses[0]}, rig.background_frame, o),
+                    Catch::Contains("at least two presses"));
+  CHECK_THROWS_WITH(to::calibrate(rig.presses, rig.background_frame, {.pixel = kPixel}),
+                    Catch::Contains("ball_radius"));
+  const to::Calibration cal = to::calibrate(rig.presses, rig.background_frame, o);
+  to::PoissonSolver solver(kRows, kCols);
+  // A frame of another resolution than the calibration's.
+  CHECK_THROWS_WITH(to::reconstruct(to::RgbFrame::zeros(480, 640), cal, solver),
+                    Catch::Contains("the frame is 480 x 640, the calibration is for 240 x 320"));
+  // An all-black frame.
+  CHECK_THROWS_WITH(to::reconstruct(to::RgbFrame::zeros(kRows, kCols), cal, solver),
+                    Catch::Contains("no gel in view"));
+  // A truncated buffer.
+  to::RgbFrame cut = rig.presses[0];
+  cut.data.resize(cut.data.size() - 1);
+  CHECK_THROWS_WITH(to::reconstruct(cut, cal, solver), Catch::Contains("rows * cols * 3 bytes"));
+  to::PoissonSolver other(kRows, kCols + 1);
+  CHECK_THROWS_WITH(to::reconstruct(rig.presses[0], cal, other),
+                    Catch::Contains("the solver is for another frame size"));
+}
