@@ -234,7 +234,7 @@ TEST_CASE("optical: bad frames, presses and options are refused with the reason"
   const to::CalibrationOptions o{.ball_radius = kBall, .pixel = kPixel};
   // A press of another size.
   std::vector<to::RgbFrame> mixed = rig.presses;
-  mixed[2] = to::RgbFrame::zeros(120, 160);
+  mixed[2] = to::RgbFrame(120, 160, 0);
   CHECK_THROWS_WITH(to::calibrate(mixed, rig.background_frame, o),
                     Catch::Contains("press 2 is 120 x 160, the background 240 x 320"));
   // A press with no contact.
@@ -253,10 +253,10 @@ TEST_CASE("optical: bad frames, presses and options are refused with the reason"
   const to::Calibration cal = to::calibrate(rig.presses, rig.background_frame, o);
   to::PoissonSolver solver(kRows, kCols);
   // A frame of another resolution than the calibration's.
-  CHECK_THROWS_WITH(to::reconstruct(to::RgbFrame::zeros(480, 640), cal, solver),
+  CHECK_THROWS_WITH(to::reconstruct(to::RgbFrame(480, 640, 0), cal, solver),
                     Catch::Contains("the frame is 480 x 640, the calibration is for 240 x 320"));
   // An all-black frame.
-  CHECK_THROWS_WITH(to::reconstruct(to::RgbFrame::zeros(kRows, kCols), cal, solver),
+  CHECK_THROWS_WITH(to::reconstruct(to::RgbFrame(kRows, kCols, 0), cal, solver),
                     Catch::Contains("no gel in view"));
   // A truncated buffer.
   to::RgbFrame cut = rig.presses[0];

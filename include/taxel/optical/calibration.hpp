@@ -35,7 +35,7 @@ namespace taxel::optical {
 /// The colour change of `frame` against `background` (I - B, per channel) [levels].
 template <class = void>
 Colour colour_change(const RgbFrame& frame, const Colour& background) {
-  frame.validate("colour_change");
+  validate_frame(frame, "colour_change");
   if (background[0].rows() != frame.rows || background[0].cols() != frame.cols) {
     throw std::invalid_argument("colour_change: the frame is " + std::to_string(frame.rows) +
                                 " x " + std::to_string(frame.cols) + ", the background " +
@@ -358,10 +358,10 @@ Calibration calibrate(const std::vector<RgbFrame>& presses, const RgbFrame& back
     throw std::invalid_argument("calibrate: " + std::to_string(circles.size()) + " circles for " +
                                 std::to_string(presses.size()) + " presses");
   }
-  background.validate("calibrate (background)");
+  validate_frame(background, "calibrate (background)");
   Calibration cal;
-  cal.rows = background.rows;
-  cal.cols = background.cols;
+  cal.rows = static_cast<int>(background.rows);
+  cal.cols = static_cast<int>(background.cols);
   cal.pixel = o.pixel;
   cal.threshold = o.threshold;
   cal.background = colour_planes(background);

@@ -39,7 +39,7 @@ struct HeightMap {
 template <class = void>
 HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolver& solver,
                       int grow = 2) {
-  frame.validate("reconstruct");
+  validate_frame(frame, "reconstruct");
   if (frame.rows != cal.rows || frame.cols != cal.cols) {
     throw std::invalid_argument("reconstruct: the frame is " + std::to_string(frame.rows) + " x " +
                                 std::to_string(frame.cols) + ", the calibration is for " +
