@@ -2,6 +2,7 @@
 // Tests of the optical layer: the transforms against their direct sums, Poisson integration
 // against exact heights, contact circles, and a calibration on rendered ball presses that
 // reconstructs held-out presses of a ball, a cylinder and an edge against the rendering's truth.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
@@ -12,6 +13,7 @@
 
 namespace to = taxel::optical;
 namespace ts = taxel::sim;
+namespace image = taxel::image;
 
 namespace {
 
@@ -227,6 +229,75 @@ TEST_CASE("optical: contacts of a height map lie on the pressed surface in the w
   CHECK(worst_normal < 0.25);
   CHECK_THROWS_WITH(to::height_contacts(map, kPixel, pose, 0, 0.02e-3, 0.05, 0, contacts),
                     Catch::Contains("stride"));
+}
+
+TEST_CASE("optical: marker dots are found, left out of calibration and filled in", "[optical]") {
+  // The rig's frames with a printed grid of dots (3 px radius, 25 px apart, 70 % darker).
+  Rig rig(12);
+  const auto dots = ts::marker_grid(kRows, kCols, 25.0);
+  const auto mark = [&](to::RgbFrame f) {
+    ts::draw_markers(f, dots, 3.0, 0.7);
+    return f;
+  };
+  // Found: every dot pixel of a press, and few others (the mask grows each dot by a pixel).
+  const to::RgbFrame press = mark(rig.presses[0]);
+  const auto found = to::marker_mask(press);
+  double in_dots = 0, hit = 0, outside = 0, false_hit = 0;
+  for (int r = 0; r < kRows; ++r) {
+    for (int c = 0; c < kCols; ++c) {
+      double nearest = 1e9;
+      for (const auto& d : dots) nearest = std::min(nearest, std::hypot(c - d.x(), r - d.y()));
+      if (nearest <= 3.0) {
+        in_dots += 1;
+        hit += found(r, c) != 0;
+      } else if (nearest > 5.0) {
+        outside += 1;
+        false_hit += found(r, c) != 0;
+      }
+    }
+  }
+  CAPTURE(hit / in_dots, false_hit / outside);
+  CHECK(hit / in_dots > 0.97);
+  CHECK(false_hit / outside < 0.001);
+  // Calibration with the dots left out beats it with them in, on held-out presses.
+  std::vector<to::RgbFrame> presses;
+  for (const auto& p : rig.presses) presses.push_back(mark(p));
+  const to::RgbFrame background = mark(rig.background_frame);
+  const to::Calibration with =
+      to::calibrate(presses, background, {.ball_radius = kBall, .pixel = kPixel});
+  const to::Calibration without =
+      to::calibrate(presses, background, {.ball_radius = kBall, .pixel = kPixel, .markers = false});
+  CAPTURE(with.heldout(), without.heldout());
+  CHECK(with.heldout() < 0.07);  // measured 0.056 (the table), 0.089 with the dots in
+  CHECK(with.heldout() < 0.8 * without.heldout());
+  // A held-out ball with dots: radius and heights as without them.
+  to::PoissonSolver solver(kRows, kCols);
+  const ts::GelPress g = ts::press_ball(kRows, kCols, kPixel, kBall, 0.5e-3, 160.0, 120.0);
+  const to::HeightMap map = to::reconstruct(mark(rig.frame(g)), with, solver);
+  const to::BallFit fit = to::fit_ball(map, kPixel);
+  CAPTURE(fit.radius);
+  CHECK(std::abs(fit.radius - kBall) < 0.1 * kBall);
+  CHECK(map.height.maxCoeff() == Approx(0.5e-3).epsilon(0.06));
+  // Filling: a constant plane's holes take the constant; a hole between two levels lies
+  // between them.
+  to::Plane plane = to::Plane::Constant(20, 30, 2.5);
+  image::Mask holes = image::Mask::Zero(20, 30);
+  holes.block(5, 5, 6, 7).setOnes();
+  plane.block(5, 5, 6, 7).setConstant(-100.0);
+  to::fill_holes(plane, holes);
+  CHECK((plane - 2.5).abs().maxCoeff() < 1e-12);
+  to::Plane ramp(20, 30);
+  for (int r = 0; r < 20; ++r) {
+    for (int c = 0; c < 30; ++c) ramp(r, c) = c;
+  }
+  to::Plane filled = ramp;
+  filled.block(5, 5, 6, 7).setConstant(1e9);
+  to::fill_holes(filled, holes);
+  CHECK(filled.block(5, 5, 6, 7).minCoeff() >= 4.0);
+  CHECK(filled.block(5, 5, 6, 7).maxCoeff() <= 12.0);
+  CHECK_THROWS_WITH(to::fill_holes(filled, image::Mask::Zero(3, 3)),
+                    Catch::Contains("differ in size"));
+  CHECK_THROWS_WITH(to::marker_mask(press, {.dark = 1.5}), Catch::Contains("dark in (0, 1)"));
 }
 
 TEST_CASE("optical: bad frames, presses and options are refused with the reason", "[optical]") {

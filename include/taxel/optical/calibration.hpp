@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "taxel/image/components.hpp"
+#include "taxel/optical/markers.hpp"
 #include "taxel/optical/types.hpp"
 
 namespace taxel::optical {
@@ -155,6 +156,8 @@ struct CalibrationOptions {
   int table_bins = 32;      ///< lookup-table cells per channel, in [4, 128]
   double ridge = 1e-6;      ///< the polynomial's ridge, relative to the features' scale
   int outside_stride = 3;   ///< every n-th pixel outside the circles is a sample of 0
+  bool markers = true;      ///< leave marker dots out (markers.hpp)
+  MarkerOptions marker{};     ///< how dots are found
 };
 
 /// A map from colour change to surface gradient, and what it was measured to do.
@@ -172,6 +175,9 @@ struct Calibration {
   double table_range = 0;              ///< the table covers changes in [-range, range) [levels]
   std::vector<float> table;            ///< bins^3 x (gx, gy)
   std::vector<Circle> circles;         ///< each press's contact circle [px]
+  bool markers = true;                 ///< marker dots are left out and filled in
+  MarkerOptions marker{};                ///< how dots are found
+  image::Mask background_markers;      ///< the background's dots (when `markers`)
   double heldout_polynomial = 0;       ///< held-out RMS gradient error of the polynomial [-]
   double heldout_table = 0;            ///< held-out RMS gradient error of the table [-]
 
@@ -365,6 +371,9 @@ Calibration calibrate(const std::vector<RgbFrame>& presses, const RgbFrame& back
   cal.pixel = o.pixel;
   cal.threshold = o.threshold;
   cal.background = colour_planes(background);
+  cal.markers = o.markers;
+  cal.marker = o.marker;
+  if (o.markers) cal.background_markers = marker_mask(background, o.marker);
   std::vector<detail::GradientSample> samples;
   const double R2 = o.ball_radius * o.ball_radius;
   for (std::size_t p = 0; p < presses.size(); ++p) {
@@ -374,7 +383,13 @@ Calibration calibrate(const std::vector<RgbFrame>& presses, const RgbFrame& back
                                   std::to_string(presses[p].cols) + ", the background " +
                                   std::to_string(cal.rows) + " x " + std::to_string(cal.cols));
     }
-    const Colour change = colour_change(presses[p], cal.background);
+    Colour change = colour_change(presses[p], cal.background);
+    image::Mask dots;
+    if (o.markers) {
+      dots = marker_mask(presses[p], o.marker);
+      dots = (dots != 0 || cal.background_markers != 0).cast<std::uint8_t>();
+      for (Plane& ch : change) ch = (dots != 0).select(0.0, ch);
+    }
     Circle circle;
     if (!circles.empty()) {
       circle = circles[p];
@@ -394,6 +409,7 @@ Calibration calibrate(const std::vector<RgbFrame>& presses, const RgbFrame& back
     const double inner = circle.radius - o.margin, outer = circle.radius + o.margin;
     for (int r = 0; r < cal.rows; ++r) {
       for (int c = 0; c < cal.cols; ++c) {
+        if (o.markers && dots(r, c)) continue;
         const double x = c - circle.cx, y = r - circle.cy;
         const double rho = std::hypot(x, y);
         detail::GradientSample s{{change[0](r, c), change[1](r, c), change[2](r, c)},

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // A frame to a height map and contacts: the colour change against the calibration's
-// background, the calibrated map to gradients, the contact mask (colour change beyond the
+// background (marker dots left out, markers.hpp), the calibrated map to gradients (the dots'
+// filled from around them), the contact mask (colour change beyond the
 // threshold, holes filled, grown by `grow` pixels), gradients set to zero outside it (the
 // untouched gel is flat; this keeps the integration's drift out of the contact), and the
 // Poisson integration (poisson.hpp, free border: a contact may reach the frame's edge) to
@@ -49,7 +50,7 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
     throw std::invalid_argument("reconstruct: the solver is for another frame size");
   }
   if (grow < 0) throw std::invalid_argument("reconstruct: grow must be >= 0");
-  const Colour change = colour_change(frame, cal.background);
+  Colour change = colour_change(frame, cal.background);
   // A frame far darker than the background (the lights off, the lens covered) or far brighter
   // (saturated) shows no gel: refused rather than read as a press over the whole frame.
   const double level = (change[0].mean() + change[1].mean() + change[2].mean()) / 3.0;
@@ -63,6 +64,14 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
         ": no gel in view (lights off, lens covered or saturated)?");
   }
   HeightMap out;
+  image::Mask dots;
+  if (cal.markers) {
+    dots = marker_mask(frame, cal.marker);
+    if (cal.background_markers.size() == dots.size()) {
+      dots = (dots != 0 || cal.background_markers != 0).cast<std::uint8_t>();
+    }
+    for (Plane& ch : change) ch = (dots != 0).select(0.0, ch);
+  }
   out.mask = contact_mask(change, cal.threshold);
   image::Mask grown = out.mask;
   for (int g = 0; g < grow; ++g) {
@@ -81,10 +90,17 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
   out.gy = Plane::Zero(cal.rows, cal.cols);
   for (int r = 0; r < cal.rows; ++r) {
     for (int c = 0; c < cal.cols; ++c) {
-      if (!grown(r, c)) continue;
+      if (!grown(r, c) || (cal.markers && dots(r, c))) continue;
       cal.gradient(change[0](r, c), change[1](r, c), change[2](r, c), r, c, out.gx(r, c),
                    out.gy(r, c));
     }
+  }
+  if (cal.markers) {
+    // The dots' gradients from around them, then zero again outside the grown mask.
+    fill_holes(out.gx, dots);
+    fill_holes(out.gy, dots);
+    out.gx = (grown != 0).select(out.gx, 0.0);
+    out.gy = (grown != 0).select(out.gy, 0.0);
   }
   const image::Mask untouched = (grown == 0).cast<std::uint8_t>();
   out.height = solver.integrate(out.gx, out.gy, cal.pixel, PoissonBorder::free, untouched);

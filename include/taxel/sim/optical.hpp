@@ -5,10 +5,13 @@
 // frame's columns, y along its rows). The gel is taken to follow the indenter exactly.
 #pragma once
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "taxel/optical/types.hpp"
 
@@ -118,6 +121,44 @@ GelPress press_edge(int rows, int cols, double pixel, double slope, double depth
     }
   }
   return g;
+}
+
+/// Centres [px] (column, row) of a square grid of marker dots `pitch` pixels apart, starting
+/// `pitch / 2` from the frame's top-left corner.
+template <class = void>
+std::vector<Eigen::Vector2d> marker_grid(int rows, int cols, double pitch) {
+  if (!(pitch >= 2) || !std::isfinite(pitch)) {
+    throw std::invalid_argument("marker_grid: pitch must be finite and >= 2 [px]");
+  }
+  std::vector<Eigen::Vector2d> out;
+  for (double y = 0.5 * pitch; y < rows; y += pitch) {
+    for (double x = 0.5 * pitch; x < cols; x += pitch) out.emplace_back(x, y);
+  }
+  return out;
+}
+
+/// Darkens `frame` by `darkness` (share of the light removed, in (0, 1]) inside discs of
+/// `radius` pixels at `centres` (column, row), as a gel's printed markers do.
+template <class = void>
+void draw_markers(optical::RgbFrame& frame, const std::vector<Eigen::Vector2d>& centres,
+                  double radius, double darkness) {
+  if (!(radius > 0) || !(darkness > 0 && darkness <= 1)) {
+    throw std::invalid_argument("draw_markers: radius > 0 and darkness in (0, 1]");
+  }
+  const auto rows = static_cast<int>(frame.rows), cols = static_cast<int>(frame.cols);
+  for (const Eigen::Vector2d& m : centres) {
+    const int r0 = std::max(0, int(std::floor(m.y() - radius))),
+              r1 = std::min(rows - 1, int(std::ceil(m.y() + radius)));
+    const int c0 = std::max(0, int(std::floor(m.x() - radius))),
+              c1 = std::min(cols - 1, int(std::ceil(m.x() + radius)));
+    for (int r = r0; r <= r1; ++r) {
+      for (int c = c0; c <= c1; ++c) {
+        if (std::hypot(c - m.x(), r - m.y()) > radius) continue;
+        std::uint8_t* p = frame.data.data() + (static_cast<std::size_t>(r) * cols + c) * 3;
+        for (int k = 0; k < 3; ++k) p[k] = static_cast<std::uint8_t>(p[k] * (1.0 - darkness) + 0.5);
+      }
+    }
+  }
 }
 
 }  // namespace taxel::sim
