@@ -300,6 +300,25 @@ TEST_CASE("optical: marker dots are found, left out of calibration and filled in
   CHECK_THROWS_WITH(to::marker_mask(press, {.dark = 1.5}), Catch::Contains("dark in (0, 1)"));
 }
 
+TEST_CASE("optical: a background from frames that mostly show the untouched gel", "[optical]") {
+  // Seven frames: four of the untouched gel with noise, three presses at different places.
+  // The per-pixel median is the gel: within the noise of the model's background everywhere,
+  // the presses included.
+  Rig rig(3);
+  std::vector<to::RgbFrame> frames = rig.presses;
+  const to::Plane zero = to::Plane::Zero(kRows, kCols);
+  for (int i = 0; i < 4; ++i)
+    frames.push_back(to::render(zero, zero, rig.background, rig.model, 2.0, rig.rng));
+  const to::Colour est = to::colour_planes(to::median_background(frames));
+  double worst = 0;
+  for (std::size_t k = 0; k < 3; ++k)
+    worst = std::max(worst, (est[k] - rig.background[k]).abs().maxCoeff());
+  CHECK(worst < 8.0);  // 2 levels of noise, rounding: the median of 7 stays within 4 sigma
+  CHECK_THROWS_WITH(to::median_background({}), Catch::Contains("no frames"));
+  frames.push_back(to::RgbFrame(10, 10, 0));
+  CHECK_THROWS_WITH(to::median_background(frames), Catch::Contains("frame 7 is 10 x 10"));
+}
+
 TEST_CASE("optical: bad frames, presses and options are refused with the reason", "[optical]") {
   Rig rig(4);
   const to::CalibrationOptions o{.ball_radius = kBall, .pixel = kPixel};

@@ -4,7 +4,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -71,6 +73,32 @@ RgbFrame to_frame(const Colour& planes) {
     }
   }
   return f;
+}
+
+/// A no-contact background estimated from frames that mostly show the gel untouched: per pixel
+/// and channel, the median of the frames (the upper one of an even count). A touch that covers
+/// a pixel in fewer than half of the frames leaves no trace. Throws std::invalid_argument for
+/// no frames or frames of different sizes.
+template <class = void>
+RgbFrame median_background(const std::vector<RgbFrame>& frames) {
+  if (frames.empty()) throw std::invalid_argument("median_background: no frames");
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    validate_frame(frames[i], "median_background");
+    if (frames[i].rows != frames[0].rows || frames[i].cols != frames[0].cols) {
+      throw std::invalid_argument(
+          "median_background: frame " + std::to_string(i) + " is " +
+          std::to_string(frames[i].rows) + " x " + std::to_string(frames[i].cols) + ", frame 0 " +
+          std::to_string(frames[0].rows) + " x " + std::to_string(frames[0].cols));
+    }
+  }
+  RgbFrame out(frames[0].rows, frames[0].cols, 0);
+  std::vector<std::uint8_t> v(frames.size());
+  for (std::size_t i = 0; i < out.data.size(); ++i) {
+    for (std::size_t f = 0; f < frames.size(); ++f) v[f] = frames[f].data[i];
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    out.data[i] = v[v.size() / 2];
+  }
+  return out;
 }
 
 }  // namespace taxel::optical
