@@ -10,12 +10,12 @@
 //    caller marks as untouched average zero. Contacts may reach the border.
 //  - zero: the height is 0 on the border, the divergence taken by central differences.
 //    Solved by the type-I discrete sine transform (DST-I).
-// Transforms through the FFT of a symmetric (DCT) or odd (DST) extension of length 2 N or
-// 2 (N + 1): X_k = Re(e^(-i pi k / 2N) Y_k) / 2 for the DCT-II, X_k = -Im(Y_k) / 2 for the
-// DST-I, two real rows sharing one complex FFT for the DST. The Laplacian's eigenvalues on
-// those bases are 2 cos(pi k / M) + 2 cos(pi l / N) - 4 (cosines) and 2 cos(pi k / (m + 1)) +
-// 2 cos(pi l / (n + 1)) - 4 (sines). The FFT is Eigen's (unsupported/Eigen/FFT, kissfft
-// inside): header-only and already a dependency, so the optical layer adds none.
+// The DCT-II takes one N-point FFT per two rows (Makhoul's reordering, below); the DST-I the
+// FFT of the odd extension of length 2 (N + 1), X_k = -Im(Y_k) / 2, two rows per FFT. The
+// Laplacian's eigenvalues on those bases are 2 cos(pi k / M) + 2 cos(pi l / N) - 4 (cosines) and 2
+// cos(pi k / (m + 1)) + 2 cos(pi l / (n + 1)) - 4 (sines). The FFT is Eigen's
+// (unsupported/Eigen/FFT, kissfft inside): header-only and already a dependency, so the optical
+// layer adds none.
 #pragma once
 
 #include <Eigen/Core>
@@ -178,49 +178,64 @@ class PoissonSolver {
     return f;
   }
 
-  // DCT-II (forward) or its inverse along rows or columns, one FFT of length 2 len per
-  // sequence.
+  // DCT-II (forward) or its inverse along rows or columns by Makhoul's reordering (Makhoul, "A
+  // fast cosine transform in one and multiple dimensions", IEEE TASSP 28(1), 1980): with
+  // v_n = x_2n and v_(N-1-n) = x_(2n+1), X_k = Re(e^(-i pi k / 2N) V_k), V the N-point FFT of v;
+  // the inverse takes V_k = e^(i pi k / 2N) (X_k - i X_(N-k)) (X_N = 0) back through the
+  // inverse FFT. Two real sequences share one complex FFT: forward, their spectra are
+  // (Z_k + conj Z_(N-k)) / 2 and (Z_k - conj Z_(N-k)) / 2i; inverse, V_a + i V_b transforms to
+  // v_a + i v_b.
   template <class = void>
   void cosine(Plane& a, bool columns, bool inverse) {
     const Eigen::Index count = columns ? a.cols() : a.rows();
     const Eigen::Index len = columns ? a.rows() : a.cols();
-    const auto size = static_cast<std::size_t>(2 * len);
+    const auto n = static_cast<std::size_t>(len);
     const auto at = [&](Eigen::Index seq, Eigen::Index k) -> double& {
       return columns ? a(k, seq) : a(seq, k);
     };
     const double pi = std::numbers::pi;
-    if (twiddle_.size() != static_cast<std::size_t>(len)) {
-      twiddle_.resize(static_cast<std::size_t>(len));
-      for (Eigen::Index k = 0; k < len; ++k) {
-        twiddle_[static_cast<std::size_t>(k)] = std::polar(1.0, -pi * double(k) / double(2 * len));
+    if (twiddle_.size() != n) {
+      twiddle_.resize(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        twiddle_[k] = std::polar(1.0, -pi * double(k) / double(2 * len));
       }
     }
-    // (The twiddles are for one length; rows and columns differ, so they are remade when the
-    // length changes.)
-    in_.assign(size, std::complex<double>(0.0, 0.0));
-    for (Eigen::Index s = 0; s < count; ++s) {
+    // Where x_j goes in v: even j to j / 2, odd j to N - 1 - (j - 1) / 2.
+    const auto slot = [n](std::size_t j) { return j % 2 == 0 ? j / 2 : n - 1 - (j - 1) / 2; };
+    in_.resize(n);
+    for (Eigen::Index s = 0; s < count; s += 2) {
+      const bool pair = s + 1 < count;
       if (!inverse) {
-        for (Eigen::Index k = 0; k < len; ++k) {
-          in_[static_cast<std::size_t>(k)] = at(s, k);
-          in_[size - 1 - static_cast<std::size_t>(k)] = at(s, k);
+        for (std::size_t j = 0; j < n; ++j) {
+          const auto jj = static_cast<Eigen::Index>(j);
+          in_[slot(j)] = std::complex<double>(at(s, jj), pair ? at(s + 1, jj) : 0.0);
         }
         fft_.fwd(out_, in_);
-        for (Eigen::Index k = 0; k < len; ++k) {
-          at(s, k) =
-              0.5 *
-              (twiddle_[static_cast<std::size_t>(k)] * out_[static_cast<std::size_t>(k)]).real();
+        for (std::size_t k = 0; k < n; ++k) {
+          const std::complex<double> z = out_[k], zc = std::conj(out_[k == 0 ? 0 : n - k]);
+          const std::complex<double> va = 0.5 * (z + zc),
+                                     vb = std::complex<double>(0, -0.5) * (z - zc);
+          const auto kk = static_cast<Eigen::Index>(k);
+          at(s, kk) = (twiddle_[k] * va).real();
+          if (pair) at(s + 1, kk) = (twiddle_[k] * vb).real();
         }
       } else {
-        // x_n = Re(sum_k w_k X_k e^(i pi k / 2N) e^(2 pi i k n / 2N)), w_0 = 1 / N, w_k = 2 / N.
-        std::fill(in_.begin(), in_.end(), std::complex<double>(0.0, 0.0));
-        for (Eigen::Index k = 0; k < len; ++k) {
-          const double w = (k == 0 ? 1.0 : 2.0) / double(len);
-          in_[static_cast<std::size_t>(k)] =
-              w * at(s, k) * std::conj(twiddle_[static_cast<std::size_t>(k)]);
+        for (std::size_t k = 0; k < n; ++k) {
+          const auto kk = static_cast<Eigen::Index>(k);
+          const auto back = static_cast<Eigen::Index>(n - k);
+          const std::complex<double> rot = std::conj(twiddle_[k]);
+          const std::complex<double> va =
+              rot * std::complex<double>(at(s, kk), k == 0 ? 0.0 : -at(s, back));
+          const std::complex<double> vb =
+              pair ? rot * std::complex<double>(at(s + 1, kk), k == 0 ? 0.0 : -at(s + 1, back))
+                   : std::complex<double>(0.0, 0.0);
+          in_[k] = va + std::complex<double>(0, 1) * vb;
         }
-        fft_.inv(out_, in_);  // scaled by 1 / size
-        for (Eigen::Index k = 0; k < len; ++k) {
-          at(s, k) = double(size) * out_[static_cast<std::size_t>(k)].real();
+        fft_.inv(out_, in_);
+        for (std::size_t j = 0; j < n; ++j) {
+          const auto jj = static_cast<Eigen::Index>(j);
+          at(s, jj) = out_[slot(j)].real();
+          if (pair) at(s + 1, jj) = out_[slot(j)].imag();
         }
       }
     }
