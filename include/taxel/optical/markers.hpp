@@ -9,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <stdexcept>
@@ -17,6 +18,39 @@
 #include "taxel/optical/types.hpp"
 
 namespace taxel::optical {
+
+namespace detail {
+// The maximum of x over [i - reach, i + reach] (clipped) for every i, in O(1) per element (van
+// Herk, "A fast algorithm for local minimum and maximum filters on rectangular and octagonal
+// kernels", Pattern Recognition Letters 13(7), 1992): prefix maxima g and suffix maxima h
+// within blocks of 2 reach + 1; a window spans at most two blocks.
+inline void running_max(const std::vector<double>& x, int reach, std::vector<double>& g,
+                        std::vector<double>& h, std::vector<double>& out) {
+  const auto n = static_cast<std::ptrdiff_t>(x.size());
+  const std::ptrdiff_t w = 2 * static_cast<std::ptrdiff_t>(reach) + 1;
+  g.resize(x.size());
+  h.resize(x.size());
+  out.resize(x.size());
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    g[k] = i % w == 0 ? x[k] : std::max(g[k - 1], x[k]);
+  }
+  for (std::ptrdiff_t i = n - 1; i >= 0; --i) {
+    const auto k = static_cast<std::size_t>(i);
+    h[k] = i == n - 1 || (i + 1) % w == 0 ? x[k] : std::max(h[k + 1], x[k]);
+  }
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const std::ptrdiff_t a = std::max<std::ptrdiff_t>(i - reach, 0);
+    const std::ptrdiff_t b = std::min<std::ptrdiff_t>(i + reach, n - 1);
+    const auto ka = static_cast<std::size_t>(a), kb = static_cast<std::size_t>(b);
+    if (a / w != b / w) {
+      out[static_cast<std::size_t>(i)] = std::max(h[ka], g[kb]);
+    } else {
+      out[static_cast<std::size_t>(i)] = a % w == 0 ? g[kb] : h[ka];
+    }
+  }
+}
+}  // namespace detail
 
 /// How dots are found.
 struct MarkerOptions {
@@ -43,29 +77,23 @@ image::Mask marker_mask(const RgbFrame& frame, const MarkerOptions& o = {}) {
   }
   // Separable running maximum: along rows, then along columns.
   Plane across(rows, cols), brightest(rows, cols);
+  std::vector<double> line, g, h, out;
   for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      double m = 0;
-      for (int k = std::max(0, c - o.reach); k <= std::min(cols - 1, c + o.reach); ++k) {
-        m = std::max(m, lum(r, k));
-      }
-      across(r, c) = m;
-    }
+    line.assign(lum.row(r).data(), lum.row(r).data() + cols);
+    detail::running_max(line, o.reach, g, h, out);
+    for (int c = 0; c < cols; ++c) across(r, c) = out[static_cast<std::size_t>(c)];
   }
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      double m = 0;
-      for (int k = std::max(0, r - o.reach); k <= std::min(rows - 1, r + o.reach); ++k) {
-        m = std::max(m, across(k, c));
-      }
-      brightest(r, c) = m;
-    }
+  for (int c = 0; c < cols; ++c) {
+    line.resize(static_cast<std::size_t>(rows));
+    for (int r = 0; r < rows; ++r) line[static_cast<std::size_t>(r)] = across(r, c);
+    detail::running_max(line, o.reach, g, h, out);
+    for (int r = 0; r < rows; ++r) brightest(r, c) = out[static_cast<std::size_t>(r)];
   }
   image::Mask mask(rows, cols);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) mask(r, c) = lum(r, c) < o.dark * brightest(r, c) ? 1 : 0;
   }
-  for (int g = 0; g < o.grow; ++g) {
+  for (int step = 0; step < o.grow; ++step) {
     const image::Mask m = mask;
     for (int r = 0; r < rows; ++r) {
       for (int c = 0; c < cols; ++c) {
@@ -91,10 +119,13 @@ void fill_holes(Plane& plane, const image::Mask& holes) {
   const auto rows = static_cast<int>(plane.rows()), cols = static_cast<int>(plane.cols());
   std::vector<int> dist(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols), -1);
   std::deque<int> queue;
+  // Seeds: the pixels outside the holes next to one (the others are never a neighbour).
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
-      if (!holes(r, c)) {
-        dist[static_cast<std::size_t>(r * cols + c)] = 0;
+      if (holes(r, c)) continue;
+      dist[static_cast<std::size_t>(r * cols + c)] = 0;
+      if ((r > 0 && holes(r - 1, c)) || (r + 1 < rows && holes(r + 1, c)) ||
+          (c > 0 && holes(r, c - 1)) || (c + 1 < cols && holes(r, c + 1))) {
         queue.push_back(r * cols + c);
       }
     }
