@@ -5,6 +5,7 @@
 #pragma once
 
 #include "taxel/optical/calibration.hpp"
+#include "taxel/optical/calibration_file.hpp"
 #include "taxel/optical/markers.hpp"
 #include "taxel/optical/poisson.hpp"
 #include "taxel/optical/reconstruct.hpp"

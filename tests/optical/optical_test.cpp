@@ -5,8 +5,12 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
 #include <numbers>
 #include <random>
+#include <string>
 #include <taxel/optical.hpp>
 #include <taxel/sim/optical.hpp>
 #include <vector>
@@ -337,6 +341,56 @@ TEST_CASE("optical: a background from frames that mostly show the untouched gel"
   CHECK_THROWS_WITH(to::median_background({}), Catch::Contains("no frames"));
   frames.push_back(to::RgbFrame(10, 10, 0));
   CHECK_THROWS_WITH(to::median_background(frames), Catch::Contains("frame 7 is 10 x 10"));
+}
+
+TEST_CASE("optical: a calibration file round-trips and damaged ones are refused", "[optical]") {
+  Rig rig(6);
+  for (const bool markers : {true, false}) {
+    const to::Calibration cal =
+        to::calibrate(rig.presses, rig.background_frame,
+                      {.ball_radius = kBall, .pixel = kPixel, .markers = markers});
+    const std::string bytes = to::encode_calibration(cal);
+    const to::Calibration back = to::decode_calibration(bytes);
+    CHECK(back.rows == cal.rows);
+    CHECK(back.method == cal.method);
+    CHECK(back.heldout() == cal.heldout());
+    CHECK(back.circles.size() == cal.circles.size());
+    CHECK(back.polynomial == cal.polynomial);
+    CHECK(back.table == cal.table);
+    CHECK(back.background_markers.size() == cal.background_markers.size());
+    // The same heights from either.
+    to::PoissonSolver solver(kRows, kCols);
+    const to::RgbFrame frame =
+        rig.frame(ts::press_ball(kRows, kCols, kPixel, kBall, 0.5e-3, 150, 110));
+    CHECK((to::reconstruct(frame, back, solver).height - to::reconstruct(frame, cal, solver).height)
+              .abs()
+              .maxCoeff() == 0.0);
+    // A file, written and read.
+    const auto path =
+        (std::filesystem::temp_directory_path() / "taxel_optical_test.txcal").string();
+    to::save_calibration(path, cal);
+    CHECK(to::encode_calibration(to::load_calibration(path)) == bytes);
+    std::filesystem::remove(path);
+  }
+  const to::Calibration cal =
+      to::calibrate(rig.presses, rig.background_frame, {.ball_radius = kBall, .pixel = kPixel});
+  const std::string bytes = to::encode_calibration(cal);
+  CHECK_THROWS_WITH(to::decode_calibration("PNG\r\n"),
+                    Catch::Contains("not a taxel optical calibration"));
+  std::string v2 = bytes;
+  v2[7] = 2;
+  CHECK_THROWS_WITH(to::decode_calibration(v2), Catch::Contains("version 2 is not supported"));
+  for (const std::size_t cut :
+       {std::size_t{12}, std::size_t{40}, bytes.size() / 2, bytes.size() - 3}) {
+    CHECK_THROWS_WITH(to::decode_calibration(bytes.substr(0, cut)), Catch::Contains("cut short"));
+  }
+  CHECK_THROWS_WITH(to::decode_calibration(bytes + "x"), Catch::Contains("1 bytes after"));
+  std::string nan_pixel = bytes;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(nan_pixel.data() + 16, &nan, 8);
+  CHECK_THROWS_WITH(to::decode_calibration(nan_pixel), Catch::Contains("pixel is not finite"));
+  CHECK_THROWS_WITH(to::load_calibration("/nonexistent/x.txcal"),
+                    Catch::Contains("/nonexistent/x.txcal"));
 }
 
 TEST_CASE("optical: bad frames, presses and options are refused with the reason", "[optical]") {
