@@ -109,9 +109,10 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
 
 /// Contacts of a height map (see the header comment), in the world through `T_world_sensor`,
 /// at `time` [s]. Each states `sigma_height` [m] along its normal and its footprint across it
-/// (stride pixels wide), and `normal_sigma` [rad] as its normal's uncertainty. Appends to `out`
-/// and returns the number appended. Throws std::invalid_argument for a stride < 1 or sigmas
-/// not finite and > 0.
+/// (stride pixels wide), and `normal_sigma` [rad] as its normal's uncertainty; its `pressure`
+/// field holds the indentation [m] (an optical sensor measures no force). Appends to `out` and
+/// returns the number appended. Throws std::invalid_argument for a stride < 1 or sigmas not
+/// finite and > 0.
 template <class = void>
 std::size_t height_contacts(const HeightMap& map, double pixel,
                             const Eigen::Isometry3d& T_world_sensor, double time,
