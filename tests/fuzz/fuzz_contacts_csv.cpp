@@ -12,7 +12,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   static const char* kHeads[] = {
-      "time,x,y,z,cxx,cxy,cxz,cyy,cyz,czz,nx,ny,nz,pressure,normal_sigma,footprint_sigma\n", "x,y,z\n", ""};
+      "time,x,y,z,cxx,cxy,cxz,cyy,cyz,czz,nx,ny,nz,pressure,normal_sigma,footprint_sigma\n",
+      "x,y,z\n", ""};
   std::string text = kHeads[data[0] % 3];
   text.append(reinterpret_cast<const char*>(data + 1), size - 1);
   try {

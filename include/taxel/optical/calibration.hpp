@@ -157,7 +157,7 @@ struct CalibrationOptions {
   double ridge = 1e-6;      ///< the polynomial's ridge, relative to the features' scale
   int outside_stride = 3;   ///< every n-th pixel outside the circles is a sample of 0
   bool markers = true;      ///< leave marker dots out (markers.hpp)
-  MarkerOptions marker{};     ///< how dots are found
+  MarkerOptions marker{};   ///< how dots are found
 };
 
 /// A map from colour change to surface gradient, and what it was measured to do.
@@ -176,7 +176,7 @@ struct Calibration {
   std::vector<float> table;            ///< bins^3 x (gx, gy)
   std::vector<Circle> circles;         ///< each press's contact circle [px]
   bool markers = true;                 ///< marker dots are left out and filled in
-  MarkerOptions marker{};                ///< how dots are found
+  MarkerOptions marker{};              ///< how dots are found
   image::Mask background_markers;      ///< the background's dots (when `markers`)
   double heldout_polynomial = 0;       ///< held-out RMS gradient error of the polynomial [-]
   double heldout_table = 0;            ///< held-out RMS gradient error of the table [-]
