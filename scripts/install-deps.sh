@@ -11,14 +11,14 @@ python=(pybind11-dev python3-dev python3-numpy python3-venv python3-setuptools p
 python_test=(python3-pytest python3-scipy python3-skimage python3-matplotlib)
 case "$what" in
   build) ;;
-  test) pkgs+=(catch2 libbenchmark-dev robin-map-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium doxygen python3-markdown "${python[@]}" "${python_test[@]}") ;;
+  test) pkgs+=(catch2 libbenchmark-dev robin-map-dev libusb-1.0-0-dev libpng-dev libjpeg-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium doxygen python3-markdown "${python[@]}" "${python_test[@]}") ;;
   # The asan preset: the tests, built with clang (a second compiler beside the ci preset's GCC).
-  asan) pkgs+=(catch2 libusb-1.0-0-dev libpng-dev umockdev libumockdev-dev clang libclang-rt-14-dev) ;;
-  bench) pkgs+=(libbenchmark-dev libpng-dev liblinear-dev robin-map-dev) ;;
-  demo) pkgs+=(libpng-dev libusb-1.0-0-dev) ;;
+  asan) pkgs+=(catch2 libusb-1.0-0-dev libpng-dev libjpeg-dev umockdev libumockdev-dev clang libclang-rt-14-dev) ;;
+  bench) pkgs+=(libbenchmark-dev libpng-dev libjpeg-dev liblinear-dev robin-map-dev) ;;
+  demo) pkgs+=(libpng-dev libjpeg-dev libusb-1.0-0-dev) ;;
   fuzz) pkgs+=(catch2 clang libclang-rt-14-dev) ;;
   python) pkgs+=("${python[@]}") ;;
-  all) pkgs+=(catch2 libbenchmark-dev robin-map-dev libusb-1.0-0-dev libpng-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium doxygen python3-markdown clang libclang-rt-14-dev "${python[@]}" "${python_test[@]}") ;;
+  all) pkgs+=(catch2 libbenchmark-dev robin-map-dev libusb-1.0-0-dev libpng-dev libjpeg-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium doxygen python3-markdown clang libclang-rt-14-dev "${python[@]}" "${python_test[@]}") ;;
   *) echo "install-deps.sh: unknown set '$what' (build|test|asan|bench|demo|fuzz|python|all)" >&2; exit 2 ;;
 esac
 

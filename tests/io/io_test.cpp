@@ -10,7 +10,9 @@
 #include <catch2/catch.hpp>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <taxel/io.hpp>
 #include <vector>
@@ -18,6 +20,9 @@
 #if defined(TAXEL_TEST_HAVE_PNG)
 #include <zlib.h>
 #include <taxel/io/png.hpp>
+#endif
+#if defined(TAXEL_TEST_HAVE_JPEG)
+#include <taxel/io/jpeg.hpp>
 #endif
 
 namespace tio = taxel::io;
@@ -795,3 +800,114 @@ TEST_CASE("npy shapes follow Python's tuple grammar", "[io][reliability]") {
                       Contains("is not a tuple of sizes"));
   }
 }
+
+TEST_CASE("io: float64 and uint8 arrays are written as numpy writes them and read back", "[io]") {
+  const std::size_t shape[] = {2, 3};
+  const std::vector<double> v = {0.0, -1.5, 1e-300, 3.25, std::numeric_limits<double>::max(), -0.0};
+  const std::string f = tio::encode_npy_f64(shape, v);
+  // numpy's header for this array, padded to 64 bytes (NEP 1).
+  CHECK(f.substr(0, 8) == std::string("\x93NUMPY\x01\x00", 8));
+  CHECK(f.find("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }") == 10);
+  const tio::NpyArray a = tio::parse_npy_header(f, "<f8>", 100);
+  REQUIRE(a.count == 6);
+  CHECK(a.data_at % 64 == 0);
+  for (std::size_t i = 0; i < v.size(); ++i) CHECK(a.value(f, i) == v[i]);
+  const std::uint8_t bytes[] = {0, 1, 254, 255, 7, 9};
+  const std::string u = tio::encode_npy_u8(shape, bytes);
+  CHECK(u.find("'descr': '|u1'") != std::string::npos);
+  const tio::NpyArray b = tio::parse_npy_header(u, "<u1>", 100);
+  for (std::size_t i = 0; i < 6; ++i) CHECK(b.value(u, i) == bytes[i]);
+  CHECK_THROWS_WITH(tio::encode_npy_f64(shape, std::vector<double>(5)),
+                    Catch::Contains("shape holds 6 values, got 5"));
+}
+
+#if defined(TAXEL_TEST_HAVE_JPEG)
+namespace {
+// A JPEG encoded by libjpeg itself (quality 95, 4:4:4), independent of the reader under test.
+std::string encode_jpeg(const tio::RgbImage& img, bool grey = false) {
+  jpeg_compress_struct info{};
+  jpeg_error_mgr err{};
+  info.err = jpeg_std_error(&err);
+  jpeg_create_compress(&info);
+  unsigned char* out = nullptr;
+  unsigned long size = 0;
+  jpeg_mem_dest(&info, &out, &size);
+  info.image_width = static_cast<JDIMENSION>(img.cols);
+  info.image_height = static_cast<JDIMENSION>(img.rows);
+  info.input_components = grey ? 1 : 3;
+  info.in_color_space = grey ? JCS_GRAYSCALE : JCS_RGB;
+  jpeg_set_defaults(&info);
+  jpeg_set_quality(&info, 95, TRUE);
+  for (int c = 0; c < info.num_components; ++c) {
+    info.comp_info[c].h_samp_factor = 1;
+    info.comp_info[c].v_samp_factor = 1;
+  }
+  jpeg_start_compress(&info, TRUE);
+  std::vector<unsigned char> row(static_cast<std::size_t>(img.cols) * 3);
+  while (info.next_scanline < info.image_height) {
+    const auto r = static_cast<Eigen::Index>(info.next_scanline);
+    for (Eigen::Index c = 0; c < img.cols; ++c) {
+      const std::uint8_t* p = img.data.data() + (r * img.cols + c) * 3;
+      if (grey) {
+        row[static_cast<std::size_t>(c)] = p[0];
+      } else {
+        std::copy_n(p, 3, row.data() + c * 3);
+      }
+    }
+    JSAMPROW ptr = row.data();
+    jpeg_write_scanlines(&info, &ptr, 1);
+  }
+  jpeg_finish_compress(&info);
+  jpeg_destroy_compress(&info);
+  std::string bytes(reinterpret_cast<const char*>(out), size);
+  std::free(out);
+  return bytes;
+}
+}  // namespace
+
+TEST_CASE("io: JPEG frames are read, and truncated or foreign files refused", "[io]") {
+  // A smooth colour ramp, which JPEG keeps within a few levels.
+  tio::RgbImage img(48, 64, 0);
+  for (Eigen::Index r = 0; r < img.rows; ++r) {
+    for (Eigen::Index c = 0; c < img.cols; ++c) {
+      std::uint8_t* p = img.at(r, c);
+      p[0] = static_cast<std::uint8_t>(40 + 2 * c);
+      p[1] = static_cast<std::uint8_t>(60 + 3 * r);
+      p[2] = static_cast<std::uint8_t>(120 + r + c);
+    }
+  }
+  const std::string bytes = encode_jpeg(img);
+  const tio::RgbImage back = tio::decode_jpeg(bytes, "ramp.jpg");
+  REQUIRE(back.rows == 48);
+  REQUIRE(back.cols == 64);
+  int worst = 0;
+  for (std::size_t i = 0; i < img.data.size(); ++i) {
+    worst = std::max(worst, std::abs(int(back.data[i]) - int(img.data[i])));
+  }
+  CHECK(worst <= 4);
+  // Greyscale is expanded to three equal channels.
+  const tio::RgbImage grey = tio::decode_jpeg(encode_jpeg(img, true), "grey.jpg");
+  REQUIRE(grey.rows == 48);
+  CHECK(grey.data[0] == grey.data[1]);
+  CHECK(grey.data[1] == grey.data[2]);
+  // From a file.
+  const auto dir = std::filesystem::temp_directory_path() / "taxel_jpeg_test";
+  std::filesystem::create_directories(dir);
+  tio::write_file((dir / "ramp.jpg").string(), bytes);
+  CHECK(tio::read_jpeg((dir / "ramp.jpg").string()).data == back.data);
+  // Cut anywhere after the header: an error, never a frame filled with grey.
+  for (const std::size_t cut :
+       {std::size_t{2}, std::size_t{200}, bytes.size() / 2, bytes.size() - 2}) {
+    CAPTURE(cut);
+    CHECK_THROWS_AS(tio::decode_jpeg(bytes.substr(0, cut), "cut.jpg"), taxel::IoError);
+  }
+  CHECK_THROWS_WITH(tio::decode_jpeg(bytes.substr(0, bytes.size() / 2), "cut.jpg"),
+                    Catch::Contains("cut.jpg") && Catch::Contains("JPEG read failed"));
+  CHECK_THROWS_WITH(tio::decode_jpeg("\x89PNG\r\n", "x.png"), Catch::Contains("not a JPEG"));
+  CHECK_THROWS_WITH(
+      tio::decode_jpeg(std::string("\xFF\xD8\xFF") + std::string(100, 'x'), "bad.jpg"),
+      Catch::Contains("JPEG read failed"));
+  CHECK_THROWS_AS(tio::read_jpeg((dir / "missing.jpg").string()), taxel::IoError);
+  std::filesystem::remove_all(dir);
+}
+#endif

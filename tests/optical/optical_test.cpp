@@ -133,6 +133,15 @@ TEST_CASE("optical: a ball press's contact circle is found to a fifth of a pixel
     CHECK(std::abs(c.cx - rig.truth[i].cx) < 0.2);
     CHECK(std::abs(c.cy - rig.truth[i].cy) < 0.2);
     CHECK(std::abs(c.radius - rig.truth[i].radius) < 0.2);
+    // The search for real gels (drape, lighting): its centre from the change's oddness, its
+    // radius at the ring of strongest change, which on a rendered press is the contact's last
+    // ring of pixels.
+    const to::Circle p = to::find_press_circle(change, {}, kBall / kPixel);
+    CAPTURE(p.cx, p.cy, p.radius);
+    CHECK(std::abs(p.cx - rig.truth[i].cx) <= 0.5);
+    CHECK(std::abs(p.cy - rig.truth[i].cy) <= 0.5);
+    CHECK(p.radius <= rig.truth[i].radius + 0.2);
+    CHECK(p.radius > rig.truth[i].radius - 1.5);
   }
   // No contact: the background frame itself.
   CHECK_THROWS_WITH(
@@ -172,6 +181,23 @@ TEST_CASE(
     CHECK(std::abs(fit.cx - cx) < 1.0);
     CHECK(std::sqrt(e / n) < 0.03e-3);  // measured: 0.008-0.014 mm
     CHECK(map.height.maxCoeff() == Approx(0.5e-3).epsilon(0.06));
+    // The contact mask: the deformed pixels at least 0.3 of the deepest height, which on a
+    // rendered ball (no drape) is the part of the contact at least 0.15 mm deep.
+    int wrong = 0, inside = 0;
+    for (int r = 0; r < kRows; ++r) {
+      for (int c = 0; c < kCols; ++c) {
+        const bool truth = g.height(r, c) >= 0.3 * 0.5e-3;
+        inside += truth;
+        // (pixels within 0.02 mm of the share's height may fall either way)
+        if (std::abs(g.height(r, c) - 0.3 * 0.5e-3) > 0.02e-3 &&
+            truth != (map.contact(r, c) != 0)) {
+          ++wrong;
+        }
+        if (map.contact(r, c)) CHECK(map.mask(r, c));
+      }
+    }
+    CAPTURE(wrong, inside);
+    CHECK(wrong < inside / 100);
   }
   // A cylinder across the whole frame (its contact reaches the border) and an edge.
   for (const bool edge : {false, true}) {
@@ -223,8 +249,6 @@ TEST_CASE("optical: contacts of a height map lie on the pressed surface in the w
     CHECK(taxel::check_contact(c) == taxel::ContactDefect::ok);
     CHECK(c.time == 1.5);
     const double dist = (c.position - centre).norm() - kBall;
-    // Outside the contact circle (the mask's fringe), the point is on the flat gel.
-    if ((c.position - centre).norm() > kBall + 0.05e-3) continue;
     worst = std::max(worst, std::abs(dist));
     worst_normal = std::max(
         worst_normal, std::acos(std::min(1.0, -c.normal->dot((centre - c.position).normalized()))));
@@ -391,6 +415,83 @@ TEST_CASE("optical: a calibration file round-trips and damaged ones are refused"
   CHECK_THROWS_WITH(to::decode_calibration(nan_pixel), Catch::Contains("pixel is not finite"));
   CHECK_THROWS_WITH(to::load_calibration("/nonexistent/x.txcal"),
                     Catch::Contains("/nonexistent/x.txcal"));
+
+  // The JSON form: readable members, the binary form inside, and the same calibration back.
+  const std::string json = to::encode_calibration_json(cal);
+  CHECK_THAT(json, Catch::Contains("\"format\": \"taxel optical calibration\""));
+  CHECK_THAT(json, Catch::Contains("\"rows\": 240"));
+  CHECK(to::encode_calibration(to::decode_calibration_any(json)) == bytes);
+  CHECK(to::encode_calibration(to::decode_calibration_any(bytes)) == bytes);
+  const auto json_path =
+      (std::filesystem::temp_directory_path() / "taxel_optical_test_cal.json").string();
+  to::save_calibration(json_path, cal);
+  CHECK(taxel::io::read_file(json_path).front() == '{');
+  CHECK(to::encode_calibration(to::load_calibration(json_path)) == bytes);
+  std::filesystem::remove(json_path);
+  // Base64 against RFC 4648's test vectors, both ways.
+  const std::pair<const char*, const char*> vectors[] = {
+      {"", ""},        {"f", "Zg=="},        {"fo", "Zm8="},
+      {"foo", "Zm9v"}, {"foob", "Zm9vYg=="}, {"foobar", "Zm9vYmFy"}};
+  for (const auto& [plain, coded] : vectors) {
+    CHECK(to::detail::base64(plain) == coded);
+    std::string back;
+    CHECK(to::detail::unbase64(coded, back));
+    CHECK(back == plain);
+  }
+  std::string junk;
+  CHECK_FALSE(to::detail::unbase64("Zm9", junk));
+  CHECK_FALSE(to::detail::unbase64("Zm=v", junk));
+  CHECK_FALSE(to::detail::unbase64("Z!9v", junk));
+  // Damaged JSON: another document, no or bad "txcal", readable members edited alone.
+  CHECK_THROWS_WITH(to::decode_calibration_any("{\"format\": \"other\"}"),
+                    Catch::Contains("not a taxel optical calibration"));
+  std::string no_data = json;
+  no_data.replace(no_data.find("\"txcal\""), 7, "\"other\"");
+  CHECK_THROWS_WITH(to::decode_calibration_any(no_data),
+                    Catch::Contains("\"txcal\" string is missing"));
+  std::string bad_data = json;
+  bad_data[bad_data.find("\"txcal\": \"") + 10] = '!';
+  CHECK_THROWS_WITH(to::decode_calibration_any(bad_data), Catch::Contains("not base64"));
+  std::string edited = json;
+  edited.replace(edited.find("\"rows\": 240"), 12, "\"rows\": 480");
+  CHECK_THROWS_WITH(to::decode_calibration_any(edited), Catch::Contains("disagree"));
+  std::string cut = json.substr(0, json.size() / 2);
+  CHECK_THROWS(to::decode_calibration_any(cut));
+}
+
+TEST_CASE("optical: frames from NPY arrays of uint8 RGB, one or a stack, C or Fortran order",
+          "[optical]") {
+  // A 3 x 4 frame and a stack of two, each value its row-major index.
+  const std::size_t one[] = {3, 4, 3}, two[] = {2, 3, 4, 3};
+  std::vector<std::uint8_t> v(72);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<std::uint8_t>(i);
+  const std::vector<to::RgbFrame> a =
+      to::decode_npy_frames(taxel::io::encode_npy_u8(one, {v.data(), 36}));
+  REQUIRE(a.size() == 1);
+  CHECK(a[0].rows == 3);
+  CHECK(a[0].cols == 4);
+  CHECK(a[0].data == std::vector<std::uint8_t>(v.begin(), v.begin() + 36));
+  const std::vector<to::RgbFrame> b = to::decode_npy_frames(taxel::io::encode_npy_u8(two, v));
+  REQUIRE(b.size() == 2);
+  CHECK(b[1].data == std::vector<std::uint8_t>(v.begin() + 36, v.end()));
+  // The same stack in Fortran order, where the first index varies fastest in the file.
+  std::string fortran = taxel::io::encode_npy_u8(two, v);
+  fortran.replace(fortran.find("False"), 5, "True ");
+  const std::size_t data_at = fortran.size() - v.size();
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::size_t f = i / 36, r = i / 12 % 3, c = i / 3 % 4, ch = i % 3;
+    fortran[data_at + f + 2 * (r + 3 * (c + 4 * ch))] = static_cast<char>(v[i]);
+  }
+  const std::vector<to::RgbFrame> fb = to::decode_npy_frames(fortran);
+  REQUIRE(fb.size() == 2);
+  CHECK(fb[0].data == b[0].data);
+  CHECK(fb[1].data == b[1].data);
+  // Float frames and grey frames are refused.
+  const std::size_t grey[] = {3, 4};
+  CHECK_THROWS_WITH(to::decode_npy_frames(taxel::io::encode_npy_f64(one, std::vector<double>(36))),
+                    Catch::Contains("must be uint8"));
+  CHECK_THROWS_WITH(to::decode_npy_frames(taxel::io::encode_npy_u8(grey, {v.data(), 12})),
+                    Catch::Contains("shape (rows, cols, 3)"));
 }
 
 TEST_CASE("optical: bad frames, presses and options are refused with the reason", "[optical]") {
@@ -406,10 +507,14 @@ TEST_CASE("optical: bad frames, presses and options are refused with the reason"
   blank[1] = rig.background_frame;
   CHECK_THROWS_WITH(to::calibrate(blank, rig.background_frame, o),
                     Catch::Contains("press 1: find_contact_circle: no contact"));
-  // A ball radius given in millimetres: the circles are wider than the "ball".
+  // A ball radius given in millimetres: the "ball" is narrower than a pixel.
   CHECK_THROWS_WITH(
       to::calibrate(rig.presses, rig.background_frame, {.ball_radius = 2e-6, .pixel = kPixel}),
-      Catch::Contains("wider than the ball"));
+      Catch::Contains("the ball's radius is 0.032 px"));
+  // Circles given by hand that are wider than the ball.
+  CHECK_THROWS_WITH(to::calibrate(rig.presses, rig.background_frame, o,
+                                  std::vector<to::Circle>(rig.presses.size(), {80, 60, 500})),
+                    Catch::Contains("press 0: its contact circle (500 px) is wider than the ball"));
   CHECK_THROWS_WITH(to::calibrate({rig.presses[0]}, rig.background_frame, o),
                     Catch::Contains("at least two presses"));
   CHECK_THROWS_WITH(to::calibrate(rig.presses, rig.background_frame, {.pixel = kPixel}),

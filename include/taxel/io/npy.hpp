@@ -306,4 +306,53 @@ inline std::string encode_npy_u16(std::span<const std::size_t> shape,
   return out;
 }
 
+namespace detail_npy {
+
+// The shape as numpy writes it ("(3, 4)", "(5,)"), checked against `count` values.
+inline std::string shape_text(std::span<const std::size_t> shape, std::size_t count,
+                              const char* who) {
+  std::size_t n = 1;
+  std::string dims;
+  for (const std::size_t d : shape) {
+    n *= d;
+    if (!dims.empty()) dims.append(", ");
+    dims.append(std::to_string(d));
+  }
+  if (n != count) {
+    throw std::invalid_argument(std::string(who) + ": shape holds " + std::to_string(n) +
+                                " values, got " + std::to_string(count));
+  }
+  if (shape.size() == 1) dims.push_back(',');
+  return "(" + dims + ")";
+}
+
+}  // namespace detail_npy
+
+/// The .npy (version 1.0, dtype '<f8') encoding of `values` with `shape`; throws
+/// std::invalid_argument when the sizes disagree.
+inline std::string encode_npy_f64(std::span<const std::size_t> shape,
+                                  std::span<const double> values) {
+  std::string out =
+      detail_npy::header_v1("<f8", detail_npy::shape_text(shape, values.size(), "encode_npy_f64"));
+  const std::size_t at = out.size();
+  out.resize(at + 8 * values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::uint64_t raw = std::bit_cast<std::uint64_t>(values[i]);
+    for (std::size_t b = 0; b < 8; ++b, raw >>= 8) {
+      out[at + 8 * i + b] = static_cast<char>(raw & 0xFF);
+    }
+  }
+  return out;
+}
+
+/// The .npy (version 1.0, dtype '|u1') encoding of `values` with `shape`; throws
+/// std::invalid_argument when the sizes disagree.
+inline std::string encode_npy_u8(std::span<const std::size_t> shape,
+                                 std::span<const std::uint8_t> values) {
+  std::string out =
+      detail_npy::header_v1("|u1", detail_npy::shape_text(shape, values.size(), "encode_npy_u8"));
+  out.append(reinterpret_cast<const char*>(values.data()), values.size());
+  return out;
+}
+
 }  // namespace taxel::io

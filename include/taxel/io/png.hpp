@@ -35,6 +35,23 @@ inline void write_png(const std::string& path, const RgbImage& img) {
   }
 }
 
+namespace detail_png {
+
+// Finishes reading a begun png_image as RGB; throws IoError naming `source`.
+inline RgbImage finish_rgb(png_image& desc, const std::string& source) {
+  desc.format = PNG_FORMAT_RGB;
+  RgbImage img(static_cast<Eigen::Index>(desc.height), static_cast<Eigen::Index>(desc.width), 0);
+  if (png_image_finish_read(&desc, nullptr, img.data.data(), static_cast<png_int_32>(img.cols * 3),
+                            nullptr) == 0) {
+    const std::string why = desc.message;
+    png_image_free(&desc);
+    throw IoError(source, "PNG read failed: " + why);
+  }
+  return img;
+}
+
+}  // namespace detail_png
+
 /// Reads a PNG file into an RGB picture (any PNG colour type is converted). Throws IoError.
 template <class = void>
 inline RgbImage read_png(const std::string& path) {
@@ -43,15 +60,19 @@ inline RgbImage read_png(const std::string& path) {
   if (png_image_begin_read_from_file(&desc, path.c_str()) == 0) {
     throw IoError(path, std::string("PNG read failed: ") + desc.message);
   }
-  desc.format = PNG_FORMAT_RGB;
-  RgbImage img(static_cast<Eigen::Index>(desc.height), static_cast<Eigen::Index>(desc.width), 0);
-  if (png_image_finish_read(&desc, nullptr, img.data.data(), static_cast<png_int_32>(img.cols * 3),
-                            nullptr) == 0) {
-    const std::string why = desc.message;
-    png_image_free(&desc);
-    throw IoError(path, "PNG read failed: " + why);
+  return detail_png::finish_rgb(desc, path);
+}
+
+/// Decodes PNG bytes into an RGB picture (any PNG colour type is converted); `source` names
+/// them in errors. Throws IoError.
+template <class = void>
+inline RgbImage decode_png(std::string_view bytes, const std::string& source = "<png>") {
+  png_image desc{};
+  desc.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_memory(&desc, bytes.data(), bytes.size()) == 0) {
+    throw IoError(source, std::string("PNG read failed: ") + desc.message);
   }
-  return img;
+  return detail_png::finish_rgb(desc, source);
 }
 
 /// Reads a greyscale PNG (8 or 16 bits per sample) as a one-frame pressure image, the samples as

@@ -21,10 +21,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "taxel/image/components.hpp"
@@ -144,6 +146,135 @@ Circle find_contact_circle(const Colour& change, double threshold = 12.0, int mi
   out.cx = ox - 0.5 * s[0];
   out.cy = oy - 0.5 * s[1];
   out.radius = std::sqrt(std::max(0.25 * (s[0] * s[0] + s[1] * s[1]) - s[2], 0.0)) + 0.5;
+  return out;
+}
+
+/// A ball press's contact circle on a real gel, whose colour also changes around the contact
+/// (the gel drapes from the ball's edge to the flat, and lighting shifts): starting from
+/// find_contact_circle's, the circle of radius at most `max_radius` [px] (the ball's radius)
+/// whose inner ring, from 0.755 times its radius to its edge, changes colour most beyond the
+/// band outside it (half its radius wide, at least 5 px). This contrast is largest at the
+/// edge of the contact, where a sphere's slope is steepest and the drape begins (the score of
+/// Yuan et al.'s GelSight calibration, MIT GelSight-lab/gelsight_driver, 2018). Pixels of
+/// `dots` (marker dots; may be empty) are left out. Centres within a third of the starting
+/// radius (at most max_radius) are searched on a 2 px grid, then on a 0.5 px grid around the
+/// best, radii on a 0.5 px grid with a parabola through the best score and its neighbours.
+/// Throws std::runtime_error as find_contact_circle does, std::invalid_argument for
+/// max_radius < 4.
+template <class = void>
+Circle find_press_circle(const Colour& change, const image::Mask& dots, double max_radius,
+                         double threshold = 12.0) {
+  if (!(max_radius >= 4)) throw std::invalid_argument("find_press_circle: max_radius < 4 px");
+  const Circle start = find_contact_circle(change, threshold);
+  const double min_radius = std::max(3.0, 0.3 * std::min(start.radius, max_radius));
+  const Eigen::Index rows = change[0].rows(), cols = change[0].cols();
+  const bool use_dots = dots.rows() == rows && dots.cols() == cols;
+  Plane m(rows, cols);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      const double a = change[0](r, c), b = change[1](r, c), d = change[2](r, c);
+      m(r, c) = use_dots && dots(r, c) ? -1.0 : std::sqrt(a * a + b * b + d * d);
+    }
+  }
+  const double top = max_radius * 1.5 + 5.0;  // the outer band's reach for the largest radius
+  const int bins = static_cast<int>(2.0 * top) + 2;
+  std::vector<double> sum(static_cast<std::size_t>(bins)), count(sum.size());
+  std::vector<double> csum(sum.size() + 1), ccount(sum.size() + 1);
+  // The best (score, radius) for a centre; radii on a 0.5 px grid from 3 px to max_radius.
+  const auto score_at = [&](double cx, double cy, double& best_r) {
+    std::fill(sum.begin(), sum.end(), 0.0);
+    std::fill(count.begin(), count.end(), 0.0);
+    const auto r0 = static_cast<Eigen::Index>(std::max(0.0, std::floor(cy - top)));
+    const auto r1 = static_cast<Eigen::Index>(std::min(double(rows - 1), std::ceil(cy + top)));
+    const auto c0 = static_cast<Eigen::Index>(std::max(0.0, std::floor(cx - top)));
+    const auto c1 = static_cast<Eigen::Index>(std::min(double(cols - 1), std::ceil(cx + top)));
+    for (Eigen::Index r = r0; r <= r1; ++r) {
+      for (Eigen::Index c = c0; c <= c1; ++c) {
+        const double v = m(r, c);
+        if (v < 0) continue;
+        const double rho = std::hypot(double(c) - cx, double(r) - cy);
+        const int k = static_cast<int>(2.0 * rho);
+        if (k >= bins) continue;
+        sum[std::size_t(k)] += v;
+        count[std::size_t(k)] += 1;
+      }
+    }
+    for (int k = 0; k < bins; ++k) {
+      csum[std::size_t(k) + 1] = csum[std::size_t(k)] + sum[std::size_t(k)];
+      ccount[std::size_t(k) + 1] = ccount[std::size_t(k)] + count[std::size_t(k)];
+    }
+    const auto mean = [&](int a, int b) {  // over bins [a, b)
+      const double n = ccount[std::size_t(b)] - ccount[std::size_t(a)];
+      return n > 0 ? (csum[std::size_t(b)] - csum[std::size_t(a)]) / n : 0.0;
+    };
+    // The ring profile, smoothed over 1.5 px, and its peak between min_radius and max_radius.
+    const int kmin = static_cast<int>(2.0 * min_radius), kmax = static_cast<int>(2.0 * max_radius);
+    std::vector<double> prof(std::size_t(kmax + 2), 0.0);
+    for (int k = std::max(1, kmin - 1); k <= kmax + 1 && k + 2 <= bins; ++k) {
+      prof[std::size_t(k)] = mean(k - 1, k + 2);
+    }
+    int at = kmin;
+    for (int k = kmin; k <= kmax; ++k) {
+      if (prof[std::size_t(k)] > prof[std::size_t(at)]) at = k;
+    }
+    double offset = 0;
+    if (at > kmin && at < kmax) {
+      const double l = prof[std::size_t(at - 1)], c = prof[std::size_t(at)],
+                   rr = prof[std::size_t(at + 1)], curve = l - 2 * c + rr;
+      if (curve < 0) offset = std::clamp(0.5 * (l - rr) / curve, -0.5, 0.5);
+    }
+    best_r = 0.5 * (double(at) + offset + 0.5);  // bin k holds radii [k / 2, (k + 1) / 2)
+    return prof[std::size_t(at)];
+  };
+  // The centre: where the colour change is most nearly odd. A slope's colour change is
+  // mostly linear in the slope, and a ball's slopes are odd about its centre, so the change at
+  // c + u and at c - u cancel; the drape and the lighting's fall-off do not move that point.
+  // Centres c on the half-pixel grid pair whole pixels c + u and c - u.
+  const double disk = std::min(max_radius, start.radius);
+  const auto oddness = [&](int hx, int hy) {  // centre (hx / 2, hy / 2)
+    double cross = 0, energy = 0;
+    const int reach = static_cast<int>(disk);
+    for (int dy = -reach; dy <= reach; ++dy) {
+      const int r1 = (hy + dy * 2) >> 1, r2 = hy - r1;  // rows r1 + r2 = hy
+      if (dy < 0 || r1 < 0 || r2 < 0 || r1 >= rows || r2 >= rows) continue;
+      for (int dx = -reach; dx <= reach; ++dx) {
+        if (dy == 0 && dx < 0) continue;  // each pair once
+        const int c1 = (hx + dx * 2) >> 1, c2 = hx - c1;
+        if (c1 < 0 || c2 < 0 || c1 >= cols || c2 >= cols) continue;
+        const double x = 0.5 * (c1 - c2), y = 0.5 * (r1 - r2);
+        if (x * x + y * y > disk * disk) continue;
+        if (m(r1, c1) < 0 || m(r2, c2) < 0) continue;
+        for (int k = 0; k < 3; ++k) {
+          const double a = change[std::size_t(k)](r1, c1), b = change[std::size_t(k)](r2, c2);
+          cross += a * b;
+          energy += 0.5 * (a * a + b * b);
+        }
+      }
+    }
+    return energy > 0 ? cross / energy : 1.0;
+  };
+  int bx = static_cast<int>(std::lround(2 * start.cx)),
+      by = static_cast<int>(std::lround(2 * start.cy));
+  const int reach = 2 * static_cast<int>(std::max(4.0, disk / 2.5));
+  double best = 2.0;
+  for (int step : {4, 1}) {
+    const int span = step == 4 ? reach : 4;
+    const int x0 = bx, y0 = by;
+    for (int i = -span; i <= span; i += step) {
+      for (int j = -span; j <= span; j += step) {
+        const double v = oddness(x0 + j, y0 + i);
+        if (v < best) {
+          best = v;
+          bx = x0 + j;
+          by = y0 + i;
+        }
+      }
+    }
+  }
+  Circle out;
+  out.cx = 0.5 * bx;
+  out.cy = 0.5 * by;
+  score_at(out.cx, out.cy, out.radius);
   return out;
 }
 
@@ -365,6 +496,12 @@ Calibration calibrate(const std::vector<RgbFrame>& presses, const RgbFrame& back
                                 std::to_string(presses.size()) + " presses");
   }
   validate_frame(background, "calibrate (background)");
+  if (o.ball_radius / o.pixel < 4) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.2g", o.ball_radius / o.pixel);
+    throw std::invalid_argument(std::string("calibrate: the ball's radius is ") + buf +
+                                " px, under 4: check ball_radius and pixel (both in metres)");
+  }
   Calibration cal;
   cal.rows = static_cast<int>(background.rows);
   cal.cols = static_cast<int>(background.cols);
@@ -395,18 +532,23 @@ Calibration calibrate(const std::vector<RgbFrame>& presses, const RgbFrame& back
       circle = circles[p];
     } else {
       try {
-        circle = find_contact_circle(change, o.threshold);
+        circle = find_press_circle(change, dots, o.ball_radius / o.pixel, o.threshold);
       } catch (const std::runtime_error& e) {
         throw std::runtime_error("calibrate: press " + std::to_string(p) + ": " + e.what());
       }
     }
     if (!(circle.radius * o.pixel < o.ball_radius)) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.4g", circle.radius);
       throw std::runtime_error("calibrate: press " + std::to_string(p) + ": its contact circle (" +
-                               std::to_string(circle.radius) +
-                               " px) is wider than the ball; check ball_radius and pixel");
+                               buf + " px) is wider than the ball; check ball_radius and pixel");
     }
     cal.circles.push_back(circle);
-    const double inner = circle.radius - o.margin, outer = circle.radius + o.margin;
+    std::size_t inside = 0;
+    // Outside, the gel is flat (slope 0) beyond the band where it drapes from the ball's edge
+    // (half the contact's radius), which is left out.
+    const double inner = circle.radius - o.margin,
+                 outer = circle.radius + std::max(o.margin, 0.5 * circle.radius);
     for (int r = 0; r < cal.rows; ++r) {
       for (int c = 0; c < cal.cols; ++c) {
         if (o.markers && dots(r, c)) continue;
@@ -428,7 +570,13 @@ Calibration calibrate(const std::vector<RgbFrame>& presses, const RgbFrame& back
           continue;
         }
         samples.push_back(s);
+        inside += s.inside;
       }
+    }
+    if (inside < 20) {
+      throw std::runtime_error("calibrate: press " + std::to_string(p) + ": only " +
+                               std::to_string(inside) +
+                               " pixels inside its contact circle (at least 20 are needed)");
     }
   }
   std::vector<char> even(presses.size()), odd(presses.size()), all(presses.size(), 1);

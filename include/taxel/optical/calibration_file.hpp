@@ -12,11 +12,21 @@
 //   polynomial uint32 features (45), then features x 2 float64, row-major (gx, gy columns)
 //   table      int32 bins (0: none), float64 range, then bins^3 x 2 float32
 // The background's marker dots are found again when the file is read.
+//
+// The same calibration as JSON (a file named *.json; encode_calibration_json): an object whose
+// readable members say what the calibration is (format "taxel optical calibration", version 1,
+// rows, cols, pixel_m, method, threshold, heldout_gradient_rms, heldout_polynomial,
+// heldout_table, circles as [cx, cy, radius] in pixels) and whose member "txcal" holds the
+// binary form above in base64 (RFC 4648). Reading takes "txcal" and checks the readable rows,
+// cols and pixel_m against it, so that a hand edit of one without the other is refused.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <string_view>
@@ -186,16 +196,161 @@ Calibration decode_calibration(std::string_view bytes,
   return cal;
 }
 
-/// Writes a calibration file (atomically: a failed write keeps the old file). Throws IoError.
-template <class = void>
-void save_calibration(const std::string& path, const Calibration& cal) {
-  io::write_file(path, encode_calibration(cal));
+namespace detail {
+
+inline constexpr char kBase64[] =
+    "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+inline std::string base64(std::string_view in) {
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < in.size(); i += 3) {
+    const std::size_t n = std::min<std::size_t>(3, in.size() - i);
+    std::uint32_t v = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      v = v << 8 | (k < n ? static_cast<unsigned char>(in[i + k]) : 0u);
+    }
+    for (std::size_t k = 0; k < 4; ++k) {
+      out.push_back(k <= n ? kBase64[(v >> (18 - 6 * k)) & 63] : '=');
+    }
+  }
+  return out;
 }
 
-/// Reads a calibration file. Throws IoError naming the file and what is wrong.
+// Decodes base64; false on a character outside the alphabet or a length not a multiple of 4.
+inline bool unbase64(std::string_view in, std::string& out) {
+  if (in.size() % 4 != 0) return false;
+  out.clear();
+  out.reserve(in.size() / 4 * 3);
+  for (std::size_t i = 0; i < in.size(); i += 4) {
+    std::uint32_t v = 0;
+    int pad = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const char c = in[i + k];
+      int d = 0;
+      if (c == '=' && i + 4 == in.size() && k >= 2) {
+        ++pad;
+      } else if (pad > 0) {
+        return false;
+      } else if (c >= 'A' && c <= 'Z') {
+        d = c - 'A';
+      } else if (c >= 'a' && c <= 'z') {
+        d = c - 'a' + 26;
+      } else if (c >= '0' && c <= '9') {
+        d = c - '0' + 52;
+      } else if (c == '+') {
+        d = 62;
+      } else if (c == '/') {
+        d = 63;
+      } else {
+        return false;
+      }
+      v = v << 6 | static_cast<std::uint32_t>(d);
+    }
+    for (int k = 0; k < 3 - pad; ++k) out.push_back(static_cast<char>((v >> (16 - 8 * k)) & 0xFF));
+  }
+  return true;
+}
+
+// The text after `"key":` in a JSON object written by encode_calibration_json (blanks skipped);
+// empty when the key is not there.
+inline std::string_view json_member(std::string_view json, std::string_view key) {
+  std::string quoted(1, '"');  // append(): GCC 12 misreports -Wrestrict on operator+ here
+  quoted.append(key).push_back('"');
+  std::size_t at = json.find(quoted);
+  if (at == std::string_view::npos) return {};
+  at = json.find_first_not_of(" \t\r\n", at + quoted.size());
+  if (at == std::string_view::npos || json[at] != ':') return {};
+  at = json.find_first_not_of(" \t\r\n", at + 1);
+  return at == std::string_view::npos ? std::string_view{} : json.substr(at);
+}
+
+inline std::string json_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace detail
+
+/// The JSON form of a calibration (see the header comment): readable members and the binary
+/// form in base64.
+template <class = void>
+std::string encode_calibration_json(const Calibration& cal) {
+  using detail::json_number;
+  std::string out = "{\n  \"format\": \"taxel optical calibration\",\n  \"version\": 1,\n";
+  out += "  \"rows\": " + std::to_string(cal.rows) + ",\n  \"cols\": " + std::to_string(cal.cols) +
+         ",\n  \"pixel_m\": " + json_number(cal.pixel) + ",\n";
+  out += std::string("  \"method\": \"") +
+         (cal.method == Calibration::Method::polynomial ? "polynomial" : "lookup_table") +
+         "\",\n  \"threshold\": " + json_number(cal.threshold) + ",\n";
+  out += "  \"heldout_gradient_rms\": " + json_number(cal.heldout()) +
+         ",\n  \"heldout_polynomial\": " + json_number(cal.heldout_polynomial) +
+         ",\n  \"heldout_table\": " + json_number(cal.heldout_table) + ",\n  \"circles\": [";
+  for (std::size_t i = 0; i < cal.circles.size(); ++i) {
+    const Circle& c = cal.circles[i];
+    out += (i ? ", [" : "[") + json_number(c.cx) + ", " + json_number(c.cy) + ", " +
+           json_number(c.radius) + "]";
+  }
+  out += "],\n  \"txcal\": \"" + detail::base64(encode_calibration(cal)) + "\"\n}\n";
+  return out;
+}
+
+/// A calibration from file bytes in either form: binary (TXOCAL) or JSON (a leading '{').
+/// Throws IoError naming `source` and what is wrong.
+template <class = void>
+Calibration decode_calibration_any(std::string_view bytes,
+                                   const std::string& source = "<calibration>") {
+  const std::size_t first = bytes.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos || bytes[first] != '{') {
+    return decode_calibration(bytes, source);
+  }
+  const std::string_view format = detail::json_member(bytes, "format");
+  if (!format.starts_with("\"taxel optical calibration\"")) {
+    throw IoError(source,
+                  "a JSON file but not a taxel optical calibration (no \"format\": "
+                  "\"taxel optical calibration\")");
+  }
+  const std::string_view data = detail::json_member(bytes, "txcal");
+  const std::size_t end = data.empty() ? std::string_view::npos : data.find('"', 1);
+  if (data.empty() || data[0] != '"' || end == std::string_view::npos) {
+    throw IoError(source, "the calibration's \"txcal\" string is missing");
+  }
+  std::string binary;
+  if (!detail::unbase64(data.substr(1, end - 1), binary)) {
+    throw IoError(source, "the calibration's \"txcal\" string is not base64");
+  }
+  Calibration cal = decode_calibration(binary, source + " (txcal)");
+  // The readable members must say what the binary form does.
+  const auto number = [&](std::string_view key) {
+    const std::string_view v = detail::json_member(bytes, key);
+    char* stop = nullptr;
+    const std::string text(v.substr(0, std::min<std::size_t>(v.size(), 40)));
+    const double x = std::strtod(text.c_str(), &stop);
+    if (v.empty() || stop == text.c_str()) {
+      throw IoError(source, "the calibration's \"" + std::string(key) + "\" is not a number");
+    }
+    return x;
+  };
+  if (number("rows") != cal.rows || number("cols") != cal.cols ||
+      !(std::abs(number("pixel_m") - cal.pixel) <= 1e-12 * cal.pixel)) {
+    throw IoError(source, "rows, cols or pixel_m disagree with the calibration in \"txcal\"");
+  }
+  return cal;
+}
+
+/// Writes a calibration file (atomically: a failed write keeps the old file): JSON when
+/// `path` ends in .json, the binary form otherwise. Throws IoError.
+template <class = void>
+void save_calibration(const std::string& path, const Calibration& cal) {
+  const bool json = path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;
+  io::write_file(path, json ? encode_calibration_json(cal) : encode_calibration(cal));
+}
+
+/// Reads a calibration file in either form. Throws IoError naming the file and what is wrong.
 template <class = void>
 Calibration load_calibration(const std::string& path) {
-  return decode_calibration(io::read_file(path), path);
+  return decode_calibration_any(io::read_file(path), path);
 }
 
 }  // namespace taxel::optical

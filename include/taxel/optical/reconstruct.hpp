@@ -1,15 +1,17 @@
 // SPDX-License-Identifier: MIT
 // A frame to a height map and contacts: the colour change against the calibration's
 // background (marker dots left out, markers.hpp), the calibrated map to gradients (the dots'
-// filled from around them), the contact mask (colour change beyond the
-// threshold, holes filled, grown by `grow` pixels), gradients set to zero outside it (the
+// filled from around them), the deformed gel's mask (colour change beyond the threshold,
+// holes filled, specks dropped, grown by `grow` pixels), gradients set to zero outside it (the
 // untouched gel is flat; this keeps the integration's drift out of the contact), and the
 // Poisson integration (poisson.hpp, free border: a contact may reach the frame's edge) to
-// heights in metres, positive into the gel, the untouched pixels averaging zero.
+// heights in metres, positive into the gel, the untouched pixels averaging zero. The contact
+// mask is the deformed pixels at least `contact_share` of the deepest height: around a
+// contact the gel drapes back to the flat, deformed but not touched.
 // Contacts, in the sensor frame: x along the frame's columns and y along its rows, from the
 // frame's centre, z = -height (the sensing face looks along +z, into the touched object, as a
-// pad's does), the normal -(gx, gy, 1) / |(gx, gy, 1)|. Every `stride`-th pixel of the mask in
-// each direction gives one, standing for a stride x stride footprint.
+// pad's does), the normal -(gx, gy, 1) / |(gx, gy, 1)|. Every `stride`-th pixel of the contact
+// mask in each direction gives one, standing for a stride x stride footprint.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -31,15 +33,25 @@ struct HeightMap {
   Plane height;      ///< [m], positive into the gel; the untouched gel averages 0
   Plane gx;          ///< d height / dx, along columns (0 outside the mask)
   Plane gy;          ///< d height / dy, along rows (0 outside the mask)
-  image::Mask mask;  ///< 1 where the gel is touched
+  image::Mask mask;  ///< 1 where the gel is deformed (its colour changed)
+  /// 1 where the object touches: deformed and at least ReconstructOptions::contact_share of
+  /// the deepest height (the gel drapes from the contact's edge back to the flat, lower).
+  image::Mask contact;
 };
 
-/// A frame's height map (see the header comment). `grow`: pixels added around the mask, >= 0.
-/// Throws std::invalid_argument for a frame of another size than the calibration's or a
-/// solver of another size.
+/// How reconstruct works a frame.
+struct ReconstructOptions {
+  int grow = 2;       ///< pixels added around the mask before integration, >= 0
+  int min_area = 30;  ///< regions of the mask under this many pixels are specks, dropped; >= 0
+  /// The contact mask's share of the deepest height, in [0, 1).
+  double contact_share = 0.3;
+};
+
+/// A frame's height map (see the header comment). Throws std::invalid_argument for a frame of
+/// another size than the calibration's, a solver of another size or options out of range.
 template <class = void>
 HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolver& solver,
-                      int grow = 2) {
+                      const ReconstructOptions& options = {}) {
   validate_frame(frame, "reconstruct");
   if (frame.rows != cal.rows || frame.cols != cal.cols) {
     throw std::invalid_argument("reconstruct: the frame is " + std::to_string(frame.rows) + " x " +
@@ -49,7 +61,11 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
   if (solver.rows() != cal.rows || solver.cols() != cal.cols) {
     throw std::invalid_argument("reconstruct: the solver is for another frame size");
   }
-  if (grow < 0) throw std::invalid_argument("reconstruct: grow must be >= 0");
+  const int grow = options.grow, min_area = options.min_area;
+  if (grow < 0 || min_area < 0 || !(options.contact_share >= 0 && options.contact_share < 1)) {
+    throw std::invalid_argument(
+        "reconstruct: grow and min_area must be >= 0, contact_share in [0, 1)");
+  }
   Colour change = colour_change(frame, cal.background);
   // A frame far darker than the background (the lights off, the lens covered) or far brighter
   // (saturated) shows no gel: refused rather than read as a press over the whole frame.
@@ -73,6 +89,16 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
     for (Plane& ch : change) ch = (dots != 0).select(0.0, ch);
   }
   out.mask = contact_mask(change, cal.threshold);
+  if (min_area > 1) {
+    // Specks (a few pixels of noise or of a dot's edge) are no contact.
+    image::Components comp;
+    const int n = comp.compute(out.mask, image::Connectivity::eight);
+    const image::Labels& lab = comp.labels();
+    for (Eigen::Index i = 0; i < out.mask.size(); ++i) {
+      const int l = lab.data()[i];
+      if (l > 0 && l <= n && comp.area(l) < min_area) out.mask.data()[i] = 0;
+    }
+  }
   image::Mask grown = out.mask;
   for (int g = 0; g < grow; ++g) {
     const image::Mask m = grown;
@@ -104,6 +130,15 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
   }
   const image::Mask untouched = (grown == 0).cast<std::uint8_t>();
   out.height = solver.integrate(out.gx, out.gy, cal.pixel, PoissonBorder::free, untouched);
+  double deepest = 0;
+  for (Eigen::Index i = 0; i < out.mask.size(); ++i) {
+    if (out.mask.data()[i]) deepest = std::max(deepest, out.height.data()[i]);
+  }
+  out.contact = image::Mask::Zero(cal.rows, cal.cols);
+  for (Eigen::Index i = 0; i < out.mask.size(); ++i) {
+    out.contact.data()[i] = out.mask.data()[i] && deepest > 0 &&
+                            out.height.data()[i] >= options.contact_share * deepest;
+  }
   return out;
 }
 
@@ -130,7 +165,7 @@ std::size_t height_contacts(const HeightMap& map, double pixel,
   std::size_t added = 0;
   for (Eigen::Index r = stride / 2; r < rows; r += stride) {
     for (Eigen::Index c = stride / 2; c < cols; c += stride) {
-      if (!map.mask(r, c)) continue;
+      if (!map.contact(r, c)) continue;
       const Vec3d local((double(c) - 0.5 * double(cols - 1)) * pixel,
                         (double(r) - 0.5 * double(rows - 1)) * pixel, -map.height(r, c));
       const Vec3d n_local = -Vec3d(map.gx(r, c), map.gy(r, c), 1.0).normalized();
@@ -151,8 +186,7 @@ std::size_t height_contacts(const HeightMap& map, double pixel,
 }
 
 /// A sphere fitted to a height map inside its contact: the algebraic least-squares sphere
-/// through the surface points (x, y, -height) of the mask's pixels whose height is at least
-/// `min_share` of the largest (the contact's flat fringe would pull it towards a plane).
+/// through the surface points (x, y, -height) of the contact mask's pixels.
 struct BallFit {
   double radius = 0;       ///< [m]
   double cx = 0;           ///< centre above this column [px]
@@ -160,16 +194,15 @@ struct BallFit {
   std::size_t points = 0;  ///< pixels used
 };
 
-/// See BallFit. Throws std::runtime_error when fewer than 10 pixels qualify.
+/// See BallFit. Throws std::runtime_error when the contact has fewer than 10 pixels.
 template <class = void>
-BallFit fit_ball(const HeightMap& map, double pixel, double min_share = 0.1) {
-  const double peak = map.height.maxCoeff();
+BallFit fit_ball(const HeightMap& map, double pixel) {
   const Eigen::Index rows = map.height.rows(), cols = map.height.cols();
   double ox = 0, oy = 0;
   std::size_t n = 0;
   for (Eigen::Index r = 0; r < rows; ++r) {
     for (Eigen::Index c = 0; c < cols; ++c) {
-      if (!map.mask(r, c) || !(map.height(r, c) >= min_share * peak) || !(peak > 0)) continue;
+      if (!map.contact(r, c)) continue;
       ox += double(c);
       oy += double(r);
       ++n;
@@ -183,7 +216,7 @@ BallFit fit_ball(const HeightMap& map, double pixel, double min_share = 0.1) {
   Eigen::Vector4d b = Eigen::Vector4d::Zero();
   for (Eigen::Index r = 0; r < rows; ++r) {
     for (Eigen::Index c = 0; c < cols; ++c) {
-      if (!map.mask(r, c) || !(map.height(r, c) >= min_share * peak)) continue;
+      if (!map.contact(r, c)) continue;
       const double x = (double(c) - ox) * pixel, y = (double(r) - oy) * pixel;
       const double z = -map.height(r, c);
       const Eigen::Vector4d v(x, y, z, 1.0);

@@ -8,11 +8,15 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "taxel/core/error.hpp"
 #include "taxel/image/types.hpp"
+#include "taxel/io/npy.hpp"
 #include "taxel/io/picture.hpp"
 
 namespace taxel::optical {
@@ -97,6 +101,41 @@ RgbFrame median_background(const std::vector<RgbFrame>& frames) {
     for (std::size_t f = 0; f < frames.size(); ++f) v[f] = frames[f].data[i];
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
     out.data[i] = v[v.size() / 2];
+  }
+  return out;
+}
+
+/// Frames from a .npy array of 8-bit RGB, as numpy holds camera frames: shape (rows, cols, 3)
+/// for one frame or (frames, rows, cols, 3) for a stack, dtype uint8. Throws IoError naming
+/// `source` for another dtype or shape.
+template <class = void>
+std::vector<RgbFrame> decode_npy_frames(std::string_view bytes,
+                                        const std::string& source = "<npy>") {
+  const io::NpyArray a = io::parse_npy_header(bytes, source, std::uint64_t{1} << 32);
+  if (a.kind != 'u' || a.width != 1) {
+    throw IoError(source, "frames must be uint8 (RGB, 0-255)");
+  }
+  const std::size_t d = a.shape.size();
+  if ((d != 3 && d != 4) || a.shape[d - 1] != 3) {
+    throw IoError(source, "frames must have shape (rows, cols, 3) or (frames, rows, cols, 3)");
+  }
+  const std::uint64_t frames = d == 4 ? a.shape[0] : 1, rows = a.shape[d - 3],
+                      cols = a.shape[d - 2];
+  if (frames == 0 || rows < 3 || cols < 3 || rows > 16384 || cols > 16384) {
+    throw IoError(source, "no frames, or a frame size out of [3, 16384]");
+  }
+  std::vector<RgbFrame> out;
+  const std::uint64_t per = rows * cols * 3;
+  for (std::uint64_t f = 0; f < frames; ++f) {
+    out.emplace_back(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols), 0);
+    if (!a.fortran_order)
+      std::memcpy(out.back().data.data(), bytes.data() + a.data_at + f * per, per);
+  }
+  if (a.fortran_order) {  // the values in file order, each to its row-major place
+    for (std::uint64_t k = 0; k < a.count; ++k) {
+      const std::uint64_t i = a.flat_index(k);
+      out[i / per].data[i % per] = static_cast<std::uint8_t>(bytes[a.data_at + k]);
+    }
   }
   return out;
 }
