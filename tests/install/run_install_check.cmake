@@ -26,8 +26,8 @@ endforeach()
 
 # The tools, when installed, run from the prefix alone (a fresh folder, nothing else on PATH).
 if(TOOLS)
-  foreach(tool taxel-simulate taxel-fuse taxel-icp taxel-recognize taxel-describe taxel-train
-               taxel-predict)
+  foreach(tool taxel-simulate taxel-fuse taxel-icp taxel-recognize taxel-describe taxel-optical
+               taxel-train taxel-predict)
     execute_process(COMMAND "${prefix}/bin/${tool}" --version RESULT_VARIABLE rc
                     OUTPUT_VARIABLE out)
     if(NOT rc EQUAL 0 OR NOT out MATCHES "^${tool} \\(taxel\\) [0-9]+\\.[0-9]+\\.[0-9]+\n$")
