@@ -7,8 +7,9 @@
 //  3. the sensor pressed along a path over a 15 mm sphere: every frame rendered, reconstructed,
 //     its contacts taken into the world through the sensor's pose and fused by ContactCloud;
 //     the fused points' error against the sphere.
-// With --out DIR it also writes the background, the presses and one frame (PNG when built with
-// libpng, else NPY) for taxel-optical.
+// With --out DIR it also writes the background, the presses, a held-out press, a dark frame and
+// six frames of the gel sliding 0.6 px per frame (PNG when built with libpng, else NPY) for
+// taxel-optical.
 //
 //   ./09_optical_sensor [--quick] [--out DIR]
 #include <cmath>
@@ -156,6 +157,17 @@ int main(int argc, char** argv) try {
     }
     save(dir, "held_out", held_out);
     save(dir, "dark", to::RgbFrame(kRows, kCols, 0));  // the lights off: refused by depth
+    // The flat gel sliding 0.6 px to the right per frame: dots for taxel-optical track.
+    for (int k = 0; k < 6; ++k) {
+      std::vector<Eigen::Vector2d> moved = render.dots;
+      for (Eigen::Vector2d& d : moved) d.x() += 0.6 * k;
+      to::RgbFrame f =
+          to::render(flat.gx, flat.gy, render.background, render.model, 2.0, render.rng);
+      ts::draw_markers(f, moved, 3.0, 0.7);
+      char stem[32];
+      std::snprintf(stem, sizeof stem, "slide_%02d", k);
+      save(dir, stem, f);
+    }
     std::printf("frames written to %s\n", out.c_str());
   }
   return 0;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // taxel-optical: camera-based tactile sensors (GelSight and DIGIT class). `calibrate` turns
 // ball presses into a calibration file; `depth` turns a frame into a height map in metres, its
-// contact mask and contacts.
+// contact mask and contacts; `track` follows the marker dots as a displacement field.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -33,6 +33,7 @@ namespace to = taxel::optical;
 constexpr const char* kUsage =
     R"(usage: taxel-optical calibrate --ball-radius R --mm-per-pixel S [options] PRESS... -o CAL
        taxel-optical depth --calibration CAL [options] FRAME -o HEIGHT.npy
+       taxel-optical track REFERENCE FRAME... [-o TRACKS.csv]
 
 Camera-based tactile sensors (GelSight, DIGIT and their kin): a camera watches a lit gel, and
 each frame's colour change says how the pressed surface slopes.
@@ -66,6 +67,11 @@ depth      reconstructs one frame: the colour change against the background, slo
                         the columns, y along the rows from the frame's centre, z = -height)
   --stride N            every N-th touched pixel each way gives a contact (default 4)
   --grow N              pixels added around the contact mask before integration (default 2)
+
+track      follows the gel's marker dots from REFERENCE (the gel at rest) through the frames,
+           in order: per frame the dots found, the tracks seen and lost, new tracks, and the
+           displacement; -o writes every track of every frame as CSV (frame, track, x0, y0,
+           x, y, dx, dy, seen; pixels). A lost dot stands where its neighbours' motion moves it.
 
 Frames are PNG or JPEG files, NPY arrays of uint8 RGB (rows, cols, 3) or stacks (frames, rows,
 cols, 3), or folders of PNG and JPEG files (in name order); - reads standard input.
@@ -121,11 +127,11 @@ Options parse(int argc, char** argv) {
   }
   Options o;
   o.command = std::string(first);
-  if (o.command != "calibrate" && o.command != "depth") {
-    die("unknown command '" + o.command + "': calibrate or depth (see --help)");
+  if (o.command != "calibrate" && o.command != "depth" && o.command != "track") {
+    die("unknown command '" + o.command + "': calibrate, depth or track (see --help)");
   }
   taxel_cli::Args args("taxel-optical", argc - 1, argv + 1);
-  const bool cal = o.command == "calibrate";
+  const bool cal = o.command == "calibrate", track = o.command == "track";
   const auto only = [&](bool ok, std::string_view a) {
     if (!ok) die(std::string(a) + " is not an option of " + o.command + " (see --help)");
   };
@@ -139,6 +145,7 @@ Options parse(int argc, char** argv) {
     } else if (a == "-o") {
       o.output = std::string(args.value());
     } else if (a == "--background") {
+      only(!track, a);
       o.background = std::string(args.value());
     } else if (a == "--ball-radius") {
       only(cal, a);
@@ -159,22 +166,22 @@ Options parse(int argc, char** argv) {
       only(cal, a);
       o.cal.markers = false;
     } else if (a == "--calibration") {
-      only(!cal, a);
+      only(!cal && !track, a);
       o.calibration = std::string(args.value());
     } else if (a == "--mask") {
-      only(!cal, a);
+      only(!cal && !track, a);
       o.mask = std::string(args.value());
     } else if (a == "--contacts") {
-      only(!cal, a);
+      only(!cal && !track, a);
       o.contacts = std::string(args.value());
     } else if (a == "--stride") {
-      only(!cal, a);
+      only(!cal && !track, a);
       o.stride = args.number<int>(1, 1024);
     } else if (a == "--contact-share") {
-      only(!cal, a);
+      only(!cal && !track, a);
       o.rec.contact_share = args.number<double>(0.0, 0.999);
     } else if (a == "--grow") {
-      only(!cal, a);
+      only(!cal && !track, a);
       o.rec.grow = args.number<int>(0, 1024);
     } else if (a.size() > 1 && a[0] == '-') {
       die("unknown option '" + std::string(a) + "' (see --help)");
@@ -182,8 +189,12 @@ Options parse(int argc, char** argv) {
       o.inputs.emplace_back(a);
     }
   }
-  if (o.output.empty()) die(o.command + " needs -o " + (cal ? "CAL" : "HEIGHT.npy"));
-  if (cal) {
+  if (o.output.empty() && !track) {
+    die(o.command + " needs -o " + (cal ? "CAL" : "HEIGHT.npy"));
+  }
+  if (track) {
+    if (o.inputs.size() < 2) die("track needs a reference frame and at least one more");
+  } else if (cal) {
     if (!(o.ball_radius > 0)) die("calibrate needs --ball-radius R");
     if (!(o.pixel > 0)) die("calibrate needs --mm-per-pixel S");
     if (o.inputs.empty()) die("calibrate needs ball presses (PRESS...)");
@@ -425,13 +436,66 @@ std::string depth(const Options& o) {
   return taxel_cli::render(report, o.format);
 }
 
+std::string track(const Options& o) {
+  std::vector<Frame> frames;
+  for (const std::string& path : o.inputs) load_frames(path, frames);
+  if (frames.size() < 2) die("track needs a reference frame and at least one more", 1);
+  const to::RgbFrame& ref = frames.front().frame;
+  to::MarkerTracker tracker(to::find_dots(ref));
+  const std::size_t reference_dots = tracker.tracks().size();
+  std::string csv = "frame,track,x0,y0,x,y,dx,dy,seen\n";
+  taxel_cli::Json list = taxel_cli::Json::array();
+  for (std::size_t f = 1; f < frames.size(); ++f) {
+    const to::RgbFrame& frame = frames[f].frame;
+    if (frame.rows != ref.rows || frame.cols != ref.cols) {
+      die(frames[f].name + " is " + std::to_string(frame.rows) + " x " +
+              std::to_string(frame.cols) + ", the reference " + std::to_string(ref.rows) + " x " +
+              std::to_string(ref.cols),
+          1);
+    }
+    const std::size_t before = tracker.tracks().size();
+    const std::vector<to::Dot> dots = to::find_dots(frame);
+    const std::size_t seen = tracker.update(dots);
+    std::size_t lost = 0;
+    double sum = 0, largest = 0;
+    for (std::size_t i = 0; i < tracker.tracks().size(); ++i) {
+      const to::MarkerTrack& t = tracker.tracks()[i];
+      if (!t.seen) ++lost;
+      const double d = std::hypot(t.dx(), t.dy());
+      if (t.seen) {
+        sum += d;
+        largest = std::max(largest, d);
+      }
+      taxel_cli::appendf(csv, "%zu,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", f, i, t.x0, t.y0, t.x,
+                         t.y, t.dx(), t.dy(), t.seen ? 1 : 0);
+    }
+    list.push_back({{"frame", f},
+                    {"file", frames[f].name},
+                    {"dots", dots.size()},
+                    {"seen", seen},
+                    {"lost", lost},
+                    {"new", tracker.tracks().size() - before},
+                    {"mean_displacement_px", seen > 0 ? sum / double(seen) : 0.0},
+                    {"max_displacement_px", largest}});
+  }
+  if (!o.output.empty()) taxel::io::write_file(o.output, csv);
+  taxel_cli::Json report = {{"command", "track"},
+                            {"reference", frames.front().name},
+                            {"reference_dots", reference_dots},
+                            {"max_step_px", tracker.max_step()}};
+  report["frames"] = std::move(list);
+  return taxel_cli::render(report, o.format);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) try {
   taxel_cli::check_stdout_at_exit("taxel-optical");
   taxel_cli::print_version_if_asked("taxel-optical", argc, argv);
   const Options opt = parse(argc, argv);
-  std::string summary = opt.command == "calibrate" ? calibrate(opt) : depth(opt);
+  std::string summary = opt.command == "calibrate" ? calibrate(opt)
+                        : opt.command == "depth"   ? depth(opt)
+                                                   : track(opt);
   if (!summary.empty() && summary.back() != '\n') summary.push_back('\n');
   std::fwrite(summary.data(), 1, summary.size(), stdout);  // checked at exit
   return 0;

@@ -87,6 +87,20 @@ if(NOT a STREQUAL b)
   message(FATAL_ERROR "depth: cal.json and cal.txcal give different heights")
 endif()
 
+# Marker tracking: the gel slides 0.6 px per frame; every dot is followed.
+file(GLOB slides "${f}/slide_*.${ext}")
+run_tool("${TOOL}" 0 track ${slides} -o tracks.csv --format json)
+json_get(ref_dots "${out}" reference_dots)
+json_length(nframes "${out}" frames)
+json_get(shift "${out}" frames 4 mean_displacement_px)
+json_get(lost "${out}" frames 4 lost)
+if(NOT nframes EQUAL 5 OR ref_dots LESS 100 OR shift LESS 2.8 OR shift GREATER 3.2 OR lost GREATER 2)
+  message(FATAL_ERROR "track: ${nframes} frames, ${ref_dots} dots, last shift ${shift} px, "
+                      "${lost} lost")
+endif()
+file(STRINGS "${WORK_DIR}/tracks.csv" tracks LIMIT_COUNT 2)
+expect("${tracks}" "^frame,track,x0,y0,x,y,dx,dy,seen;1,0,")
+
 # Bad usage: exit 2, one line, nothing written.
 foreach(args
     "calibrate"
@@ -97,7 +111,9 @@ foreach(args
     "depth;--calibration;cal.json;--ball-radius;2;x.png;-o;bad.npy"
     "depth;--calibration;cal.json;x.png;-o;-"
     "depth;--calibration;cal.json;${f}/held_out.${ext};-o;cal.json"
-    "depth;--calibration;cal.json;${f}/held_out.${ext};-o;bad.npy;--mask;bad.npy")
+    "depth;--calibration;cal.json;${f}/held_out.${ext};-o;bad.npy;--mask;bad.npy"
+    "track;${f}/slide_00.${ext}"
+    "track;--calibration;cal.json;${f}/slide_00.${ext};${f}/slide_01.${ext}")
   run_tool("${TOOL}" 2 ${args})
   expect_one_line("${err}")
   expect("${err}" "^taxel-optical: ")

@@ -10,4 +10,5 @@
 #include "taxel/optical/poisson.hpp"
 #include "taxel/optical/reconstruct.hpp"
 #include "taxel/optical/shading.hpp"
+#include "taxel/optical/tracking.hpp"
 #include "taxel/optical/types.hpp"

@@ -11,6 +11,7 @@ import taxel.fusion
 import taxel.image
 import taxel.io
 import taxel.learn
+import taxel.optical
 import taxel.registration
 import taxel.sensor
 import taxel.sim
@@ -65,6 +66,7 @@ from taxel import fusion as fusion
 from taxel import image as image
 from taxel import io as io
 from taxel import learn as learn
+from taxel import optical as optical
 from taxel import registration as registration
 from taxel import sensor as sensor
 from taxel import sim as sim

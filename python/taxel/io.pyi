@@ -11,6 +11,7 @@ import taxel.fusion
 import taxel.image
 import taxel.io
 import taxel.learn
+import taxel.optical
 import taxel.registration
 import taxel.sensor
 import taxel.sim

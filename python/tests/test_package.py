@@ -37,7 +37,7 @@ def test_version_and_submodules():
 
 def test_every_public_callable_is_documented():
     undocumented = []
-    for sub in ("fusion", "image", "io", "learn", "registration", "sensor", "sim"):
+    for sub in ("fusion", "image", "io", "learn", "optical", "registration", "sensor", "sim"):
         mod = getattr(taxel, sub)
         for name in dir(mod):
             obj = getattr(mod, name)

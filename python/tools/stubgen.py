@@ -17,7 +17,7 @@ import sys
 import taxel
 from taxel import _taxel
 
-SUBMODULES = ("fusion", "image", "io", "learn", "registration", "sensor", "sim")
+SUBMODULES = ("fusion", "image", "io", "learn", "optical", "registration", "sensor", "sim")
 # Return types that pybind11 spells `object` (the function returns one of several types).
 RETURNS = {
     "segment": "typing.Union[taxel.image.Segmentation, typing.List[taxel.image.Segmentation]]",

@@ -535,3 +535,110 @@ TEST_CASE("optical: bad frames, presses and options are refused with the reason"
   CHECK_THROWS_WITH(to::reconstruct(rig.presses[0], cal, other),
                     Catch::Contains("the solver is for another frame size"));
 }
+
+TEST_CASE("optical: marker dots are tracked as a displacement field through lost and new dots",
+          "[optical]") {
+  to::ShadingModel model;
+  const to::Colour background = to::render_background(model, kRows, kCols);
+  const to::Plane flat = to::Plane::Zero(kRows, kCols);
+  std::mt19937_64 rng(5);
+  // A lattice 20 px apart, reaching two pitches beyond the frame so that dots can enter.
+  const double pitch = 20.0, xc = 0.5 * (kCols - 1), yc = 0.5 * (kRows - 1);
+  std::vector<Eigen::Vector2d> lattice;
+  for (double y = -30; y < kRows + 40; y += pitch) {
+    for (double x = -30; x < kCols + 40; x += pitch) lattice.emplace_back(x + 0.3, y + 0.7);
+  }
+  // The gel sheared, turned and shifted a little more every frame.
+  const auto displaced = [&](const Eigen::Vector2d& p, int k) {
+    const double s = 0.006 * k, t = 1.0 * k;
+    return Eigen::Vector2d(p.x() + s * (p.y() - yc) + t, p.y() - 0.5 * s * (p.x() - xc));
+  };
+  const auto inside = [&](const Eigen::Vector2d& p) {
+    return p.x() >= 4 && p.y() >= 4 && p.x() <= kCols - 5 && p.y() <= kRows - 5;
+  };
+  const auto draw = [&](int k, double drop) {
+    std::vector<Eigen::Vector2d> centres;
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (const Eigen::Vector2d& p : lattice) {
+      const Eigen::Vector2d q = displaced(p, k);
+      if (inside(q) && u(rng) >= drop) centres.push_back(q);
+    }
+    to::RgbFrame f = to::render(flat, flat, background, model, 2.0, rng);
+    ts::draw_markers(f, centres, 3.0, 0.7);
+    return f;
+  };
+  // The reference: every dot found, each within 0.15 px of its centre.
+  const std::vector<to::Dot> ref = to::find_dots(draw(0, 0.0));
+  std::size_t expected = 0;
+  for (const Eigen::Vector2d& p : lattice) expected += inside(p);
+  REQUIRE(ref.size() == expected);
+  // The lattice point a position belongs to at frame k (its nearest displaced point).
+  const auto truth = [&](double x, double y, int k) {
+    std::size_t best = 0;
+    double d = 1e300;
+    for (std::size_t i = 0; i < lattice.size(); ++i) {
+      const double e = (displaced(lattice[i], k) - Eigen::Vector2d(x, y)).norm();
+      if (e < d) {
+        d = e;
+        best = i;
+      }
+    }
+    return std::pair{best, d};
+  };
+  for (const to::Dot& d : ref) CHECK(truth(d.x, d.y, 0).second < 0.15);
+  to::MarkerTracker tracker(ref);
+  CHECK(tracker.max_step() == Approx(0.4 * pitch).epsilon(0.02));
+  std::vector<std::size_t> identity;  // each reference track's lattice point
+  for (const to::Dot& d : ref) identity.push_back(truth(d.x, d.y, 0).first);
+  double worst_seen = 0, worst_lost = 0, worst_new = 0;
+  std::size_t lost = 0, fresh = 0;
+  for (int k = 1; k <= 16; ++k) {
+    tracker.update(to::find_dots(draw(k, 0.1)));  // a tenth of the dots hidden every frame
+    const auto& tracks = tracker.tracks();
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      const to::MarkerTrack& t = tracks[i];
+      if (i < identity.size()) {
+        // A reference dot: at its own lattice point's displaced place (no swaps), or predicted
+        // near it when hidden or gone out of the frame.
+        const Eigen::Vector2d want = displaced(lattice[identity[i]], k);
+        const double e = (Eigen::Vector2d(t.x, t.y) - want).norm();
+        if (t.seen) {
+          worst_seen = std::max(worst_seen, e);
+        } else if (inside(want)) {
+          worst_lost = std::max(worst_lost, e);
+          ++lost;
+        }
+      } else if (t.seen) {
+        // A dot that entered: its reference is where its lattice point was at rest.
+        const auto [at, d] = truth(t.x, t.y, k);
+        worst_new = std::max(worst_new, (Eigen::Vector2d(t.x0, t.y0) - lattice[at]).norm());
+        CHECK(d < 0.3);
+        ++fresh;
+      }
+    }
+  }
+  CAPTURE(worst_seen, worst_lost, worst_new, lost, fresh);
+  CHECK(worst_seen < 0.35);  // measured 0.27 px: a rendered dot is whole pixels
+  CHECK(worst_lost < 1.0);   // measured 0.23 px
+  CHECK(worst_new < 1.0);
+  CHECK(lost > 100);
+  CHECK(fresh > 10);
+  // The dense field at the lattice points inside, against the truth.
+  to::Plane fx, fy;
+  tracker.field(kRows, kCols, fx, fy);
+  double worst_field = 0;
+  for (const Eigen::Vector2d& p : lattice) {
+    const Eigen::Vector2d q = displaced(p, 16);
+    if (!inside(q)) continue;
+    const auto r = static_cast<int>(std::lround(q.y())), c = static_cast<int>(std::lround(q.x()));
+    // The field is sampled where the gel point now is; compare with its displacement.
+    worst_field = std::max(worst_field, std::hypot(fx(r, c) - (q - p).x(), fy(r, c) - (q - p).y()));
+  }
+  CHECK(worst_field < 1.0);  // measured 0.40 px
+  // A dark frame has no dots; the tracks are then all lost, none found.
+  CHECK(to::find_dots(to::RgbFrame(kRows, kCols, 0)).empty());
+  to::MarkerTracker blind(ref);
+  CHECK(blind.update({}) == 0);
+  CHECK_THROWS_WITH(to::MarkerTracker(std::vector<to::Dot>(1)), Catch::Contains("fewer than two"));
+  CHECK_THROWS_WITH(to::find_dots(draw(0, 0.0), {}, 5, 2), Catch::Contains("min_area"));
+}
