@@ -71,12 +71,16 @@ const char* method_name(to::Calibration::Method m) {
   return m == to::Calibration::Method::polynomial ? "polynomial" : "lookup_table";
 }
 
-/// A reconstructor: a calibration and the Poisson solver for its frame size.
+/// A reconstructor: its own copy of a calibration (whose background may follow a drift), and
+/// the Poisson solver for its frame size.
 struct Reconstructor {
-  std::shared_ptr<const to::Calibration> calibration;
+  to::Calibration calibration;
   to::PoissonSolver solver;
-  explicit Reconstructor(std::shared_ptr<const to::Calibration> c)
-      : calibration(std::move(c)), solver(calibration->rows, calibration->cols) {}
+  double drift_rate = 0;
+  Reconstructor(const to::Calibration& c, double rate)
+      : calibration(c), solver(c.rows, c.cols), drift_rate(rate) {
+    if (!(rate >= 0 && rate <= 1)) throw py::value_error("drift_rate must be in [0, 1]");
+  }
 };
 
 py::dict height_map_dict(const to::HeightMap& m) {
@@ -92,8 +96,10 @@ py::dict height_map_dict(const to::HeightMap& m) {
 to::HeightMap run(Reconstructor& r, const ArrayU8& frame, const to::ReconstructOptions& o) {
   const to::RgbFrame f = frame_from(frame, "reconstruct");
   py::gil_scoped_release release;
-  const auto lock = write_lock(&r);  // the solver's workspace
-  return to::reconstruct(f, *r.calibration, r.solver, o);
+  const auto lock = write_lock(&r);  // the solver's workspace and the background
+  to::HeightMap map = to::reconstruct(f, r.calibration, r.solver, o);
+  if (r.drift_rate > 0) to::track_background(r.calibration, f, map, r.drift_rate);
+  return map;
 }
 
 }  // namespace
@@ -220,14 +226,22 @@ RuntimeError naming a press without contact.)doc");
 Frames to height maps with one calibration: keeps the Poisson solver of the calibration's frame
 size, so that a stream of frames does not plan it again. Calls on one reconstructor run one at
 a time; use one per thread to run them together.)doc")
-      .def(py::init([](const CalPtr& c) { return Reconstructor(c); }), py::arg("calibration"),
-           "A reconstructor for frames of the calibration's size.")
+      .def(py::init(
+               [](const CalPtr& c, double drift_rate) { return Reconstructor(*c, drift_rate); }),
+           py::arg("calibration"), py::kw_only(), py::arg("drift_rate") = 0.0,
+           "A reconstructor for frames of the calibration's size. With `drift_rate` > 0 its "
+           "background follows a slow drift of the lighting: after each frame it moves toward "
+           "the frame by that share where the gel is untouched.")
       .def_property_readonly(
           "calibration",
           [](const Reconstructor& r) {
-            return std::const_pointer_cast<to::Calibration>(r.calibration);
+            const auto lock = read_lock(&r);
+            return std::make_shared<to::Calibration>(r.calibration);
           },
-          "The calibration in use.")
+          "A copy of the calibration in use (its background as followed so far).")
+      .def_property_readonly(
+          "drift_rate", [](const Reconstructor& r) { return r.drift_rate; },
+          "The share by which the background follows each frame (0: it stays).")
       .def(
           "__call__",
           [](Reconstructor& r, const ArrayU8& frame, int grow, int min_area, double contact_share) {
@@ -244,14 +258,14 @@ positive into the gel, the untouched gel averaging 0), 'gx' and 'gy' (slopes), '
 the deformed gel) and 'contact' (bool, the deformed pixels at least `contact_share` of the
 deepest height). Raises ValueError for a frame of another size or one with no gel in view.)doc")
       .def("__repr__", [](const Reconstructor& r) {
-        return "<Reconstructor " + std::to_string(r.calibration->rows) + "x" +
-               std::to_string(r.calibration->cols) + ">";
+        return "<Reconstructor " + std::to_string(r.calibration.rows) + "x" +
+               std::to_string(r.calibration.cols) + (r.drift_rate > 0 ? ", following drift>" : ">");
       });
 
   o.def(
       "reconstruct",
       [](const ArrayU8& frame, const CalPtr& calibration, double contact_share) {
-        Reconstructor r(calibration);
+        Reconstructor r(*calibration, 0.0);
         to::ReconstructOptions opt;
         opt.contact_share = contact_share;
         return height_map_dict(run(r, frame, opt));

@@ -60,10 +60,12 @@ class Reconstructor:
     """Frames to height maps with one calibration: keeps the Poisson solver of the calibration's frame
 size, so that a stream of frames does not plan it again. Calls on one reconstructor run one at
 a time; use one per thread to run them together."""
-    def __init__(self, calibration: taxel.optical.Calibration) -> None: """A reconstructor for frames of the calibration's size."""
+    def __init__(self, calibration: taxel.optical.Calibration, *, drift_rate: float = 0.0) -> None: """A reconstructor for frames of the calibration's size. With `drift_rate` > 0 its background follows a slow drift of the lighting: after each frame it moves toward the frame by that share where the gel is untouched."""
     def __repr__(self) -> str: ...
     @property
     def calibration(self) -> taxel.optical.Calibration: ...
+    @property
+    def drift_rate(self) -> float: ...
 
 def calibrate(presses: object, background: numpy.typing.NDArray[numpy.uint8], *, ball_radius: float, pixel: float, circles: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, threshold: float = 12.0, table_bins: int = 32, markers: bool = True) -> taxel.optical.Calibration: """Calibrates from ball presses over a no-contact `background` frame. `presses` is a list of (rows, cols, 3) uint8 frames or one (frames, rows, cols, 3) array; `ball_radius` and `pixel` (the gel's size of one pixel) are in metres. Each press's contact circle is found (``Calibration.circles``) unless `circles` gives them, (presses, 3) as centre column, centre row and radius in pixels. Raises ValueError for bad options or sizes and RuntimeError naming a press without contact."""
 

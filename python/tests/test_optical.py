@@ -145,3 +145,23 @@ def test_marker_dots_are_tracked_through_a_shift():
     assert "MarkerTracker" in repr(tracker)
     with pytest.raises(ValueError, match="fewer than two"):
         optical.MarkerTracker(ref[:1])
+
+
+def test_a_reconstructor_follows_a_drift_of_the_lighting(rig):
+    rng, _, _, _, cal = rig
+    zero = np.zeros((ROWS, COLS))
+    h, gx, gy = ball(0.4e-3, 80, 60)
+    follow = optical.Reconstructor(cal, drift_rate=0.05)
+    assert follow.drift_rate == 0.05 and "following drift" in repr(follow)
+    for k in range(1, 121):
+        pressed = k % 10 == 0
+        frame = render(gx if pressed else zero, gy if pressed else zero, rng)
+        # The lamp brightens by 0.2 % a frame: 24 % after 120 frames.
+        frame = np.clip(np.rint(frame * (1 + 0.002 * k)), 0, 255).astype(np.uint8)
+        m = follow(frame)
+    inside = h > 0
+    assert np.sqrt(np.mean((m["height"][inside] - h[inside]) ** 2)) < 0.05e-3
+    assert m["mask"].mean() < 0.1
+    assert optical.Reconstructor(cal)(frame)["mask"].mean() > 0.5  # without it, all deformed
+    with pytest.raises(ValueError, match="drift_rate"):
+        optical.Reconstructor(cal, drift_rate=2.0)

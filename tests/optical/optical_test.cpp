@@ -642,3 +642,46 @@ TEST_CASE("optical: marker dots are tracked as a displacement field through lost
   CHECK_THROWS_WITH(to::MarkerTracker(std::vector<to::Dot>(1)), Catch::Contains("fewer than two"));
   CHECK_THROWS_WITH(to::find_dots(draw(0, 0.0), {}, 5, 2), Catch::Contains("min_area"));
 }
+
+TEST_CASE("optical: a slow drift of the lighting is followed by the background", "[optical]") {
+  Rig rig(8);
+  const to::Calibration cal =
+      to::calibrate(rig.presses, rig.background_frame, {.ball_radius = kBall, .pixel = kPixel});
+  to::Calibration tracked = cal;
+  to::PoissonSolver solver(kRows, kCols);
+  const to::Plane zero = to::Plane::Zero(kRows, kCols);
+  const ts::GelPress press = ts::press_ball(kRows, kCols, kPixel, kBall, 0.5e-3, 150, 110);
+  // The lamp brightens by 0.15 % a frame, 25 % over 150 frames; a ball is pressed in every
+  // tenth frame.
+  for (int k = 1; k <= 150; ++k) {
+    to::Colour lit = rig.background;
+    for (to::Plane& p : lit) p *= 1.0 + 0.0015 * k;
+    const bool pressed = k % 10 == 0;
+    const to::RgbFrame f = to::render(pressed ? press.gx : zero, pressed ? press.gy : zero, lit,
+                                      rig.model, 2.0, rig.rng);
+    const to::HeightMap map = to::reconstruct(f, tracked, solver);
+    to::track_background(tracked, f, map);
+    if (k < 150) continue;
+    // The last frame is pressed: with the background followed, the heights hold.
+    double e = 0, n = 0;
+    for (int r = 0; r < kRows; ++r) {
+      for (int c = 0; c < kCols; ++c) {
+        if (press.height(r, c) <= 0) continue;
+        e += (map.height(r, c) - press.height(r, c)) * (map.height(r, c) - press.height(r, c));
+        n += 1;
+      }
+    }
+    const double touched = double(map.mask.cast<int>().sum()) / double(kRows * kCols);
+    CAPTURE(std::sqrt(e / n), touched);
+    CHECK(std::sqrt(e / n) < 0.03e-3);
+    CHECK(touched < 0.1);
+    // Without it the whole gel reads as deformed.
+    const to::HeightMap stale = to::reconstruct(f, cal, solver);
+    CHECK(double(stale.mask.cast<int>().sum()) / double(kRows * kCols) > 0.5);
+  }
+  CHECK_THROWS_WITH(to::track_background(tracked, rig.presses[0], to::HeightMap{}, 0.05),
+                    Catch::Contains("differ in size"));
+  const to::HeightMap any = to::reconstruct(rig.presses[0], cal, solver);
+  CHECK_THROWS_WITH(to::track_background(tracked, rig.presses[0], any, 0.0),
+                    Catch::Contains("rate in (0, 1]"));
+}

@@ -18,12 +18,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "taxel/core/contact.hpp"
 #include "taxel/optical/calibration.hpp"
+#include "taxel/optical/markers.hpp"
 #include "taxel/optical/poisson.hpp"
 
 namespace taxel::optical {
@@ -140,6 +142,57 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
                             out.height.data()[i] >= options.contact_share * deepest;
   }
   return out;
+}
+
+/// Follows a slow drift of the lighting (a warming lamp, a camera's auto exposure): moves the
+/// calibration's background toward `frame` by `rate` (an exponential average over about
+/// 1 / rate frames) where `map`, the frame's height map, shows the gel untouched, more than
+/// `margin` pixels from its mask. Call it after each frame's reconstruct. The background's
+/// marker dots stay where they were found. Throws std::invalid_argument for sizes that differ,
+/// a rate outside (0, 1] or a negative margin.
+template <class = void>
+void track_background(Calibration& cal, const RgbFrame& frame, const HeightMap& map,
+                      double rate = 0.05, int margin = 10) {
+  validate_frame(frame, "track_background");
+  if (frame.rows != cal.rows || frame.cols != cal.cols || map.mask.rows() != cal.rows ||
+      map.mask.cols() != cal.cols) {
+    throw std::invalid_argument(
+        "track_background: the frame, the map and the calibration differ in size");
+  }
+  if (!(rate > 0 && rate <= 1) || margin < 0) {
+    throw std::invalid_argument("track_background: rate in (0, 1] and margin >= 0 are needed");
+  }
+  // The untouched pixels: outside the mask grown by `margin` (a square reach, by a separable
+  // running maximum of the mask).
+  const auto rows = static_cast<int>(cal.rows), cols = static_cast<int>(cal.cols);
+  Plane near(rows, cols);
+  std::vector<double> line, g, h, out;
+  for (int r = 0; r < rows; ++r) {
+    line.resize(static_cast<std::size_t>(cols));
+    for (int c = 0; c < cols; ++c) line[static_cast<std::size_t>(c)] = map.mask(r, c) ? 1.0 : 0.0;
+    if (margin > 0) {
+      detail::running_max(line, margin, g, h, out);
+    } else {
+      out = line;
+    }
+    for (int c = 0; c < cols; ++c) near(r, c) = out[static_cast<std::size_t>(c)];
+  }
+  for (int c = 0; c < cols && margin > 0; ++c) {
+    line.resize(static_cast<std::size_t>(rows));
+    for (int r = 0; r < rows; ++r) line[static_cast<std::size_t>(r)] = near(r, c);
+    detail::running_max(line, margin, g, h, out);
+    for (int r = 0; r < rows; ++r) near(r, c) = out[static_cast<std::size_t>(r)];
+  }
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (near(r, c) > 0) continue;
+      const std::uint8_t* p = frame.data.data() + (static_cast<std::size_t>(r) * cols + c) * 3;
+      for (int k = 0; k < 3; ++k) {
+        double& b = cal.background[static_cast<std::size_t>(k)](r, c);
+        b += rate * (double(p[k]) - b);
+      }
+    }
+  }
 }
 
 /// Contacts of a height map (see the header comment), in the world through `T_world_sensor`,
