@@ -685,3 +685,54 @@ TEST_CASE("optical: a slow drift of the lighting is followed by the background",
   CHECK_THROWS_WITH(to::track_background(tracked, rig.presses[0], any, 0.0),
                     Catch::Contains("rate in (0, 1]"));
 }
+
+TEST_CASE("optical: the reconstruction's mask equals the calibration's mask less its specks",
+          "[optical]") {
+  // Random blobs and rings of colour change on noise: touched_mask (specks first, holes
+  // within the box) against contact_mask (holes over the frame) with specks removed after.
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int rows = 30 + int(40 * u(rng)), cols = 30 + int(40 * u(rng));
+    to::Colour change;
+    for (to::Plane& p : change) p = to::Plane::Zero(rows, cols);
+    const int blobs = 1 + int(4 * u(rng));
+    for (int b = 0; b < blobs; ++b) {
+      const double cx = cols * u(rng), cy = rows * u(rng), outer = 2 + 10 * u(rng),
+                   inner = u(rng) < 0.5 ? 0.0 : outer * u(rng);
+      for (int r = 0; r < rows; ++r) {
+        for (int c = 0; c < cols; ++c) {
+          const double d = std::hypot(c - cx, r - cy);
+          if (d < outer && d >= inner) change[0](r, c) = 40;
+        }
+      }
+    }
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        if (u(rng) < 0.02) change[1](r, c) = 30;  // specks
+      }
+    }
+    const int min_area = trial % 2 == 0 ? 0 : 6;
+    image::Mask expect = to::contact_mask(change, 12.0);
+    if (min_area > 1) {
+      // The specks of the thresholded change (before holes are filled), then the holes.
+      image::Mask raw(rows, cols);
+      for (Eigen::Index i = 0; i < raw.size(); ++i) {
+        const double a = change[0].data()[i], b = change[1].data()[i];
+        raw.data()[i] = a * a + b * b > 144 ? 1 : 0;
+      }
+      image::Components comp;
+      const int n = comp.compute(raw, image::Connectivity::eight);
+      for (Eigen::Index i = 0; i < raw.size(); ++i) {
+        const int l = comp.labels().data()[i];
+        if (l > 0 && l <= n && comp.area(l) < min_area) raw.data()[i] = 0;
+      }
+      to::Colour kept;
+      for (to::Plane& p : kept) p = to::Plane::Zero(rows, cols);
+      for (Eigen::Index i = 0; i < raw.size(); ++i) kept[0].data()[i] = raw.data()[i] ? 40 : 0;
+      expect = to::contact_mask(kept, 12.0);
+    }
+    CAPTURE(trial);
+    CHECK((to::touched_mask(change, 12.0, min_area) == expect).all());
+  }
+}

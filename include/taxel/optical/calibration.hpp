@@ -45,8 +45,13 @@ Colour colour_change(const RgbFrame& frame, const Colour& background) {
                                 std::to_string(background[0].rows()) + " x " +
                                 std::to_string(background[0].cols()));
   }
-  Colour c = colour_planes(frame);
-  for (std::size_t k = 0; k < 3; ++k) c[k] -= background[k];
+  Colour c;
+  for (Plane& p : c) p.resize(frame.rows, frame.cols);
+  const std::uint8_t* px = frame.data.data();
+  const Eigen::Index n = frame.rows * frame.cols;
+  for (Eigen::Index i = 0; i < n; ++i, px += 3) {  // (row-major planes: one index each)
+    for (std::size_t k = 0; k < 3; ++k) c[k].data()[i] = double(px[k]) - background[k].data()[i];
+  }
   return c;
 }
 
@@ -80,6 +85,64 @@ image::Mask contact_mask(const Colour& change, double threshold) {
     for (Eigen::Index c = 0; c < cols; ++c) {
       const auto l = lab(r, c);
       if (l > 0 && !border[static_cast<std::size_t>(l)]) mask(r, c) = 1;
+    }
+  }
+  return mask;
+}
+
+/// contact_mask as reconstruction takes it: 8-connected regions of fewer than `min_area`
+/// changed pixels (specks of noise or of a dot's edge) are dropped first, then the holes of what
+/// remains are filled, searched only within its bounding box widened by a pixel (a region of
+/// the complement that reaches that box's border reaches the frame's outside too).
+template <class = void>
+image::Mask touched_mask(const Colour& change, double threshold, int min_area) {
+  const Eigen::Index rows = change[0].rows(), cols = change[0].cols();
+  image::Mask mask(rows, cols);
+  const double t2 = threshold * threshold;
+  for (Eigen::Index i = 0; i < mask.size(); ++i) {
+    const double a = change[0].data()[i], b = change[1].data()[i], d = change[2].data()[i];
+    mask.data()[i] = a * a + b * b + d * d > t2 ? 1 : 0;
+  }
+  image::Components comp;
+  if (min_area > 1) {
+    const int n = comp.compute(mask, image::Connectivity::eight);
+    const image::Labels& lab = comp.labels();
+    for (Eigen::Index i = 0; i < mask.size(); ++i) {
+      const int l = lab.data()[i];
+      if (l > 0 && l <= n && comp.area(l) < min_area) mask.data()[i] = 0;
+    }
+  }
+  Eigen::Index r0 = rows, r1 = -1, c0 = cols, c1 = -1;
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      if (!mask(r, c)) continue;
+      r0 = std::min(r0, r);
+      r1 = std::max(r1, r);
+      c0 = std::min(c0, c);
+      c1 = std::max(c1, c);
+    }
+  }
+  if (r1 < 0) return mask;
+  r0 = std::max<Eigen::Index>(r0 - 1, 0);
+  c0 = std::max<Eigen::Index>(c0 - 1, 0);
+  r1 = std::min<Eigen::Index>(r1 + 1, rows - 1);
+  c1 = std::min<Eigen::Index>(c1 + 1, cols - 1);
+  const Eigen::Index h = r1 - r0 + 1, w = c1 - c0 + 1;
+  const image::Mask outside = (mask.block(r0, c0, h, w) == 0).cast<std::uint8_t>();
+  const int n = comp.compute(outside, image::Connectivity::four);
+  std::vector<char> border(static_cast<std::size_t>(n) + 1, 0);
+  const image::Labels& lab = comp.labels();
+  for (Eigen::Index r = 0; r < h; ++r) {
+    for (Eigen::Index c = 0; c < w; ++c) {
+      if (r == 0 || c == 0 || r == h - 1 || c == w - 1) {
+        border[static_cast<std::size_t>(lab(r, c))] = 1;
+      }
+    }
+  }
+  for (Eigen::Index r = 0; r < h; ++r) {
+    for (Eigen::Index c = 0; c < w; ++c) {
+      const auto l = lab(r, c);
+      if (l > 0 && !border[static_cast<std::size_t>(l)]) mask(r0 + r, c0 + c) = 1;
     }
   }
   return mask;

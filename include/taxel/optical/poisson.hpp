@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <complex>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -48,6 +49,22 @@ class PoissonSolver {
     m_ = rows - 2;
     n_ = cols - 2;
     work_.resize(m_, n_);
+  }
+
+  /// A solver for rows x cols planes, no larger than this one's: this one for its own size,
+  /// else one kept for reuse (the 16 most recently made). reconstruct integrates a contact's
+  /// neighbourhood through it.
+  PoissonSolver& part(int rows, int cols) {
+    if (rows > rows_ || cols > cols_) {
+      throw std::invalid_argument("PoissonSolver::part: larger than the solver's planes");
+    }
+    if (rows == rows_ && cols == cols_) return *this;
+    for (auto& p : parts_) {
+      if (p->rows() == rows && p->cols() == cols) return *p;
+    }
+    if (parts_.size() >= 16) parts_.erase(parts_.begin());
+    parts_.push_back(std::make_unique<PoissonSolver>(rows, cols));
+    return *parts_.back();
   }
 
   /// Rows of the planes this solver takes.
@@ -157,13 +174,20 @@ class PoissonSolver {
     }
     dct_rows(f);
     dct_cols(f);
-    const double pi = std::numbers::pi;
+    // The Laplacian's eigenvalues, 2 cos(pi r / rows) + 2 cos(pi c / cols) - 4, from cosines
+    // computed once per solver.
+    if (cos_rows_.empty()) {
+      const double pi = std::numbers::pi;
+      for (int r = 0; r < rows_; ++r) cos_rows_.push_back(2.0 * std::cos(pi * r / rows_) - 4.0);
+      for (int c = 0; c < cols_; ++c) cos_cols_.push_back(2.0 * std::cos(pi * c / cols_));
+    }
     for (int r = 0; r < rows_; ++r) {
-      const double cr = 2.0 * std::cos(pi * r / rows_) - 4.0;
-      for (int c = 0; c < cols_; ++c) {
-        f(r, c) = r == 0 && c == 0 ? 0.0 : f(r, c) / (cr + 2.0 * std::cos(pi * c / cols_));
+      const double cr = cos_rows_[static_cast<std::size_t>(r)];
+      for (int c = r == 0 ? 1 : 0; c < cols_; ++c) {
+        f(r, c) /= cr + cos_cols_[static_cast<std::size_t>(c)];
       }
     }
+    f(0, 0) = 0.0;  // the mean, free
     idct_rows(f);
     idct_cols(f);
     double sum = 0, n = 0;
@@ -269,6 +293,8 @@ class PoissonSolver {
 
   int rows_, cols_, m_, n_;
   Plane work_;
+  std::vector<double> cos_rows_, cos_cols_;            // integrate_free's eigenvalue terms
+  std::vector<std::unique_ptr<PoissonSolver>> parts_;  // part()'s solvers, oldest first
   Eigen::FFT<double> fft_;
   std::vector<std::complex<double>> in_, out_, twiddle_;
 };

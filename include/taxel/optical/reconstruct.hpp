@@ -90,48 +90,79 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
     }
     for (Plane& ch : change) ch = (dots != 0).select(0.0, ch);
   }
-  out.mask = contact_mask(change, cal.threshold);
-  if (min_area > 1) {
-    // Specks (a few pixels of noise or of a dot's edge) are no contact.
-    image::Components comp;
-    const int n = comp.compute(out.mask, image::Connectivity::eight);
-    const image::Labels& lab = comp.labels();
-    for (Eigen::Index i = 0; i < out.mask.size(); ++i) {
-      const int l = lab.data()[i];
-      if (l > 0 && l <= n && comp.area(l) < min_area) out.mask.data()[i] = 0;
+  out.mask = touched_mask(change, cal.threshold, min_area);
+  // The mask's bounding box, grown with it: the loops below stay inside it.
+  int r0 = cal.rows, r1 = -1, c0 = cal.cols, c1 = -1;
+  for (int r = 0; r < cal.rows; ++r) {
+    for (int c = 0; c < cal.cols; ++c) {
+      if (!out.mask(r, c)) continue;
+      r0 = std::min(r0, r);
+      r1 = std::max(r1, r);
+      c0 = std::min(c0, c);
+      c1 = std::max(c1, c);
     }
   }
   image::Mask grown = out.mask;
-  for (int g = 0; g < grow; ++g) {
-    const image::Mask m = grown;
-    for (int r = 0; r < cal.rows; ++r) {
-      for (int c = 0; c < cal.cols; ++c) {
+  for (int g = 0; g < grow && r1 >= 0; ++g) {
+    r0 = std::max(r0 - 1, 0);
+    c0 = std::max(c0 - 1, 0);
+    r1 = std::min(r1 + 1, cal.rows - 1);
+    c1 = std::min(c1 + 1, cal.cols - 1);
+    const image::Mask m = grown.block(r0, c0, r1 - r0 + 1, c1 - c0 + 1);
+    const int h = r1 - r0 + 1, w = c1 - c0 + 1;
+    for (int r = 0; r < h; ++r) {
+      for (int c = 0; c < w; ++c) {
         if (m(r, c)) continue;
-        if ((r > 0 && m(r - 1, c)) || (r + 1 < cal.rows && m(r + 1, c)) || (c > 0 && m(r, c - 1)) ||
-            (c + 1 < cal.cols && m(r, c + 1))) {
-          grown(r, c) = 1;
+        if ((r > 0 && m(r - 1, c)) || (r + 1 < h && m(r + 1, c)) || (c > 0 && m(r, c - 1)) ||
+            (c + 1 < w && m(r, c + 1))) {
+          grown(r0 + r, c0 + c) = 1;
         }
       }
     }
   }
   out.gx = Plane::Zero(cal.rows, cal.cols);
   out.gy = Plane::Zero(cal.rows, cal.cols);
-  for (int r = 0; r < cal.rows; ++r) {
-    for (int c = 0; c < cal.cols; ++c) {
+  for (int r = r0; r <= r1; ++r) {
+    for (int c = c0; c <= c1; ++c) {
       if (!grown(r, c) || (cal.markers && dots(r, c))) continue;
       cal.gradient(change[0](r, c), change[1](r, c), change[2](r, c), r, c, out.gx(r, c),
                    out.gy(r, c));
     }
   }
-  if (cal.markers) {
-    // The dots' gradients from around them, then zero again outside the grown mask.
-    fill_holes(out.gx, dots);
-    fill_holes(out.gy, dots);
-    out.gx = (grown != 0).select(out.gx, 0.0);
-    out.gy = (grown != 0).select(out.gy, 0.0);
+  if (cal.markers && r1 >= 0) {
+    // The dots' gradients from around them (within the grown mask's box, widened by the dots'
+    // reach), then zero again outside the grown mask.
+    const int reach = cal.marker.reach + 1;
+    const int br0 = std::max(r0 - reach, 0), bc0 = std::max(c0 - reach, 0);
+    const int bh = std::min(r1 + reach, cal.rows - 1) - br0 + 1;
+    const int bw = std::min(c1 + reach, cal.cols - 1) - bc0 + 1;
+    const image::Mask holes = dots.block(br0, bc0, bh, bw);
+    for (Plane* g : {&out.gx, &out.gy}) {
+      Plane part = g->block(br0, bc0, bh, bw);
+      fill_holes(part, holes);
+      g->block(br0, bc0, bh, bw) = (grown.block(br0, bc0, bh, bw) != 0).select(part, 0.0);
+    }
   }
-  const image::Mask untouched = (grown == 0).cast<std::uint8_t>();
-  out.height = solver.integrate(out.gx, out.gy, cal.pixel, PoissonBorder::free, untouched);
+  // Only the contact's neighbourhood is integrated: the grown mask's bounding box, widened by
+  // half its size and at least 16 pixels each way, its sides rounded up to multiples of 32
+  // pixels (so that few solver sizes recur) within the frame. Outside it the gel is flat, at
+  // height 0; inside, the untouched pixels average 0. A frame without contact is flat.
+  out.height = Plane::Zero(cal.rows, cal.cols);
+  if (r1 >= 0) {
+    const auto window = [](int lo, int hi, int size, int& start, int& length) {
+      const int pad = std::max(16, (hi - lo + 1) / 2);
+      length = std::min(size, ((hi - lo + 1 + 2 * pad + 31) / 32) * 32);
+      start = std::clamp((lo + hi + 1) / 2 - length / 2, 0, size - length);
+    };
+    int top = 0, rows = 0, left = 0, cols = 0;
+    window(r0, r1, static_cast<int>(cal.rows), top, rows);
+    window(c0, c1, static_cast<int>(cal.cols), left, cols);
+    const image::Mask untouched = (grown.block(top, left, rows, cols) == 0).cast<std::uint8_t>();
+    out.height.block(top, left, rows, cols) =
+        solver.part(rows, cols)
+            .integrate(out.gx.block(top, left, rows, cols), out.gy.block(top, left, rows, cols),
+                       cal.pixel, PoissonBorder::free, untouched);
+  }
   double deepest = 0;
   for (Eigen::Index i = 0; i < out.mask.size(); ++i) {
     if (out.mask.data()[i]) deepest = std::max(deepest, out.height.data()[i]);
