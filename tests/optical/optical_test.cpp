@@ -736,3 +736,24 @@ TEST_CASE("optical: the reconstruction's mask equals the calibration's mask less
     CHECK((to::touched_mask(change, 12.0, min_area) == expect).all());
   }
 }
+
+TEST_CASE("optical: the 2-D running maximum of the marker search equals the brute-force one",
+          "[optical]") {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int t = 0; t < 60; ++t) {
+    const int rows = 1 + int(rng() % 30), cols = 1 + int(rng() % 30), reach = 1 + int(rng() % 7);
+    to::Plane x(rows, cols);
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) x(r, c) = u(rng);
+    }
+    const to::Plane m = to::detail::running_max_2d(x, reach);
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        const int r0 = std::max(0, r - reach), r1 = std::min(rows - 1, r + reach);
+        const int c0 = std::max(0, c - reach), c1 = std::min(cols - 1, c + reach);
+        REQUIRE(m(r, c) == x.block(r0, c0, r1 - r0 + 1, c1 - c0 + 1).maxCoeff());
+      }
+    }
+  }
+}

@@ -20,35 +20,79 @@
 namespace taxel::optical {
 
 namespace detail {
-// The maximum of x over [i - reach, i + reach] (clipped) for every i, in O(1) per element (van
-// Herk, "A fast algorithm for local minimum and maximum filters on rectangular and octagonal
-// kernels", Pattern Recognition Letters 13(7), 1992): prefix maxima g and suffix maxima h
-// within blocks of 2 reach + 1; a window spans at most two blocks.
+// The maximum over [i - reach, i + reach] (clipped) for every i of a sequence, in O(1) per
+// element (van Herk, "A fast algorithm for local minimum and maximum filters on rectangular and
+// octagonal kernels", Pattern Recognition Letters 13(7), 1992): prefix maxima g and suffix
+// maxima h within blocks of w = 2 reach + 1; a full window [a, a + w - 1] spans at most two
+// blocks and its maximum is max(h[a], g[a + w - 1]). Windows clipped at the ends are prefix or
+// suffix maxima of the whole sequence. The elements are doubles (one sequence) or the rows of
+// a plane (its columns at once: the same steps, element-wise); x, g, h and out give element i.
+template <class Get, class G, class H, class Out, class Max, class Copy>
+void van_herk(int n, int reach, Get x, G g, H h, Out out, Max max, Copy copy) {
+  const int w = 2 * reach + 1;
+  for (int b = 0; b < n; b += w) {
+    const int e = std::min(b + w, n);
+    copy(g(b), x(b));
+    for (int i = b + 1; i < e; ++i) max(g(i), g(i - 1), x(i));
+    copy(h(e - 1), x(e - 1));
+    for (int i = e - 2; i >= b; --i) max(h(i), h(i + 1), x(i));
+  }
+  // Clipped at the start: [0, i + reach] for i < reach + 1; at the end: [i - reach, n - 1].
+  const int head = std::min(n, reach + 1), tail = std::max(head, n - reach);
+  if (head > 0) {
+    copy(out(0), x(0));
+    for (int k = 1; k <= std::min(reach, n - 1); ++k) max(out(0), out(0), x(k));
+    for (int i = 1; i < head; ++i) {
+      copy(out(i), out(i - 1));
+      if (i + reach < n) max(out(i), out(i), x(i + reach));
+    }
+  }
+  for (int i = head; i < tail; ++i) max(out(i), h(i - reach), g(i + reach));
+  if (tail < n) {
+    copy(out(n - 1), x(n - 1));
+    for (int k = n - 2; k >= std::max(0, n - 1 - reach); --k) max(out(n - 1), out(n - 1), x(k));
+    for (int i = n - 2; i >= tail; --i) {
+      copy(out(i), out(i + 1));
+      if (i - reach >= 0) max(out(i), out(i), x(i - reach));
+    }
+  }
+}
+
+// The 1-D running maximum of x (see van_herk) into out; g and h are workspace.
 inline void running_max(const std::vector<double>& x, int reach, std::vector<double>& g,
                         std::vector<double>& h, std::vector<double>& out) {
-  const auto n = static_cast<std::ptrdiff_t>(x.size());
-  const std::ptrdiff_t w = 2 * static_cast<std::ptrdiff_t>(reach) + 1;
+  const auto n = static_cast<int>(x.size());
   g.resize(x.size());
   h.resize(x.size());
   out.resize(x.size());
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    g[k] = i % w == 0 ? x[k] : std::max(g[k - 1], x[k]);
+  const auto at = [](std::vector<double>& v) {
+    return [&v](int i) -> double& { return v[static_cast<std::size_t>(i)]; };
+  };
+  van_herk(
+      n, reach, [&](int i) { return x[static_cast<std::size_t>(i)]; }, at(g), at(h), at(out),
+      [](double& to, double a, double b) { to = std::max(a, b); },
+      [](double& to, double a) { to = a; });
+}
+
+// The running maximum over (2 reach + 1)^2 squares (clipped at the borders) of a plane: along
+// each row, then along the columns a whole row at a time.
+inline Plane running_max_2d(const Plane& x, int reach) {
+  const auto rows = static_cast<int>(x.rows()), cols = static_cast<int>(x.cols());
+  Plane across(rows, cols), out(rows, cols);
+  std::vector<double> line, g, h, res;
+  for (int r = 0; r < rows; ++r) {
+    line.assign(x.row(r).data(), x.row(r).data() + cols);
+    running_max(line, reach, g, h, res);
+    std::copy(res.begin(), res.end(), across.row(r).data());
   }
-  for (std::ptrdiff_t i = n - 1; i >= 0; --i) {
-    const auto k = static_cast<std::size_t>(i);
-    h[k] = i == n - 1 || (i + 1) % w == 0 ? x[k] : std::max(h[k + 1], x[k]);
-  }
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    const std::ptrdiff_t a = std::max<std::ptrdiff_t>(i - reach, 0);
-    const std::ptrdiff_t b = std::min<std::ptrdiff_t>(i + reach, n - 1);
-    const auto ka = static_cast<std::size_t>(a), kb = static_cast<std::size_t>(b);
-    if (a / w != b / w) {
-      out[static_cast<std::size_t>(i)] = std::max(h[ka], g[kb]);
-    } else {
-      out[static_cast<std::size_t>(i)] = a % w == 0 ? g[kb] : h[ka];
-    }
-  }
+  Plane gp(rows, cols), hp(rows, cols);
+  using Row = decltype(out.row(0));
+  van_herk(
+      rows, reach, [&](int i) { return across.row(i); }, [&](int i) { return gp.row(i); },
+      [&](int i) { return hp.row(i); }, [&](int i) { return out.row(i); },
+      [](Row to, const auto& a, const auto& b) { to = a.max(b); },
+      [](Row to, const auto& a) { to = a; });
+  return out;
 }
 }  // namespace detail
 
@@ -75,20 +119,7 @@ image::Mask marker_mask(const RgbFrame& frame, const MarkerOptions& o = {}) {
       lum(r, c) = (double(p[0]) + p[1] + p[2]) / 3.0;
     }
   }
-  // Separable running maximum: along rows, then along columns.
-  Plane across(rows, cols), brightest(rows, cols);
-  std::vector<double> line, g, h, out;
-  for (int r = 0; r < rows; ++r) {
-    line.assign(lum.row(r).data(), lum.row(r).data() + cols);
-    detail::running_max(line, o.reach, g, h, out);
-    for (int c = 0; c < cols; ++c) across(r, c) = out[static_cast<std::size_t>(c)];
-  }
-  for (int c = 0; c < cols; ++c) {
-    line.resize(static_cast<std::size_t>(rows));
-    for (int r = 0; r < rows; ++r) line[static_cast<std::size_t>(r)] = across(r, c);
-    detail::running_max(line, o.reach, g, h, out);
-    for (int r = 0; r < rows; ++r) brightest(r, c) = out[static_cast<std::size_t>(r)];
-  }
+  const Plane brightest = detail::running_max_2d(lum, o.reach);
   image::Mask mask(rows, cols);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) mask(r, c) = lum(r, c) < o.dark * brightest(r, c) ? 1 : 0;
