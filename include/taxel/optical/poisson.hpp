@@ -218,10 +218,12 @@ class PoissonSolver {
       return columns ? a(k, seq) : a(seq, k);
     };
     const double pi = std::numbers::pi;
-    if (twiddle_.size() != n) {
-      twiddle_.resize(n);
+    // The twiddles of this length, computed once per direction (rows and columns differ).
+    std::vector<std::complex<double>>& twiddle = twiddles_[columns ? 1 : 0];
+    if (twiddle.size() != n) {
+      twiddle.resize(n);
       for (std::size_t k = 0; k < n; ++k) {
-        twiddle_[k] = std::polar(1.0, -pi * double(k) / double(2 * len));
+        twiddle[k] = std::polar(1.0, -pi * double(k) / double(2 * len));
       }
     }
     // Where x_j goes in v: even j to j / 2, odd j to N - 1 - (j - 1) / 2.
@@ -240,14 +242,14 @@ class PoissonSolver {
           const std::complex<double> va = 0.5 * (z + zc),
                                      vb = std::complex<double>(0, -0.5) * (z - zc);
           const auto kk = static_cast<Eigen::Index>(k);
-          at(s, kk) = (twiddle_[k] * va).real();
-          if (pair) at(s + 1, kk) = (twiddle_[k] * vb).real();
+          at(s, kk) = (twiddle[k] * va).real();
+          if (pair) at(s + 1, kk) = (twiddle[k] * vb).real();
         }
       } else {
         for (std::size_t k = 0; k < n; ++k) {
           const auto kk = static_cast<Eigen::Index>(k);
           const auto back = static_cast<Eigen::Index>(n - k);
-          const std::complex<double> rot = std::conj(twiddle_[k]);
+          const std::complex<double> rot = std::conj(twiddle[k]);
           const std::complex<double> va =
               rot * std::complex<double>(at(s, kk), k == 0 ? 0.0 : -at(s, back));
           const std::complex<double> vb =
@@ -296,7 +298,8 @@ class PoissonSolver {
   std::vector<double> cos_rows_, cos_cols_;            // integrate_free's eigenvalue terms
   std::vector<std::unique_ptr<PoissonSolver>> parts_;  // part()'s solvers, oldest first
   Eigen::FFT<double> fft_;
-  std::vector<std::complex<double>> in_, out_, twiddle_;
+  std::vector<std::complex<double>> in_, out_;
+  std::vector<std::complex<double>> twiddles_[2];  // cosine()'s, along rows and along columns
 };
 
 }  // namespace taxel::optical
