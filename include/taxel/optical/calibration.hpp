@@ -286,7 +286,8 @@ Circle find_press_circle(const Colour& change, const image::Mask& dots, double m
                    rr = prof[std::size_t(at + 1)], curve = l - 2 * c + rr;
       if (curve < 0) offset = std::clamp(0.5 * (l - rr) / curve, -0.5, 0.5);
     }
-    best_r = 0.5 * (double(at) + offset + 0.5);  // bin k holds radii [k / 2, (k + 1) / 2)
+    // (bin k holds radii [k / 2, (k + 1) / 2); kept inside the ball, whose edge is vertical)
+    best_r = std::min(0.5 * (double(at) + offset + 0.5), 0.98 * max_radius);
     return prof[std::size_t(at)];
   };
   // The centre: where the colour change is most nearly odd. A slope's colour change is
