@@ -56,44 +56,11 @@ Colour colour_change(const RgbFrame& frame, const Colour& background) {
 }
 
 /// The pixels whose colour change exceeds `threshold` levels (Euclidean over the channels),
-/// with the holes of each region filled (a ball's centre, flat, barely changes colour).
-template <class = void>
-image::Mask contact_mask(const Colour& change, double threshold) {
-  const Eigen::Index rows = change[0].rows(), cols = change[0].cols();
-  image::Mask mask(rows, cols);
-  const double t2 = threshold * threshold;
-  for (Eigen::Index r = 0; r < rows; ++r) {
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      const double a = change[0](r, c), b = change[1](r, c), d = change[2](r, c);
-      mask(r, c) = a * a + b * b + d * d > t2 ? 1 : 0;
-    }
-  }
-  // Holes: regions of the complement that do not reach the border (4-connected).
-  image::Mask outside = (mask == 0).cast<std::uint8_t>();
-  image::Components comp;
-  const int n = comp.compute(outside, image::Connectivity::four);
-  std::vector<char> border(static_cast<std::size_t>(n) + 1, 0);
-  const image::Labels& lab = comp.labels();
-  for (Eigen::Index r = 0; r < rows; ++r) {
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      if (r == 0 || c == 0 || r == rows - 1 || c == cols - 1) {
-        border[static_cast<std::size_t>(lab(r, c))] = 1;
-      }
-    }
-  }
-  for (Eigen::Index r = 0; r < rows; ++r) {
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      const auto l = lab(r, c);
-      if (l > 0 && !border[static_cast<std::size_t>(l)]) mask(r, c) = 1;
-    }
-  }
-  return mask;
-}
-
-/// contact_mask as reconstruction takes it: 8-connected regions of fewer than `min_area`
-/// changed pixels (specks of noise or of a dot's edge) are dropped first, then the holes of what
-/// remains are filled, searched only within its bounding box widened by a pixel (a region of
-/// the complement that reaches that box's border reaches the frame's outside too).
+/// less the 8-connected regions of fewer than `min_area` of them (specks of noise or of a dot's
+/// edge; 0 keeps every region), with the holes of what remains filled (a ball's centre, flat,
+/// barely changes colour): the regions of the complement that do not reach the frame's border
+/// (4-connected), searched within the mask's bounding box widened by a pixel (a region that
+/// reaches that box's border reaches the outside too).
 template <class = void>
 image::Mask touched_mask(const Colour& change, double threshold, int min_area) {
   const Eigen::Index rows = change[0].rows(), cols = change[0].cols();
@@ -146,6 +113,13 @@ image::Mask touched_mask(const Colour& change, double threshold, int min_area) {
     }
   }
   return mask;
+}
+
+/// The pixels whose colour change exceeds `threshold` levels, with the holes of each region
+/// filled (touched_mask keeping every region).
+template <class = void>
+image::Mask contact_mask(const Colour& change, double threshold) {
+  return touched_mask(change, threshold, 0);
 }
 
 /// A contact circle in pixels: centre (column, row) and radius.
