@@ -67,6 +67,16 @@ py::array_t<bool> mask_array(const image::Mask& m) {
   return out;
 }
 
+/// Dots from find_dots' (dots, 3) array: column, row, area.
+std::vector<to::Dot> dots_from(const ArrayD& dots) {
+  require_shape(dots, {-1, 3}, "dots", "(dots, 3)");
+  std::vector<to::Dot> v;
+  for (py::ssize_t i = 0; i < dots.shape(0); ++i) {
+    v.push_back({dots.at(i, 0), dots.at(i, 1), dots.at(i, 2)});
+  }
+  return v;
+}
+
 const char* method_name(to::Calibration::Method m) {
   return m == to::Calibration::Method::polynomial ? "polynomial" : "lookup_table";
 }
@@ -323,12 +333,7 @@ deepest height). Raises ValueError for a frame of another size or one with no ge
 Follows marker dots from a frame of the gel at rest through later frames, as a displacement
 field: lost dots are placed by their neighbours' motion, new dots start new tracks.)doc")
       .def(py::init([](const ArrayD& dots, double max_step) {
-             require_shape(dots, {-1, 3}, "dots", "(dots, 3)");
-             std::vector<to::Dot> v;
-             for (py::ssize_t i = 0; i < dots.shape(0); ++i) {
-               v.push_back({dots.at(i, 0), dots.at(i, 1), dots.at(i, 2)});
-             }
-             return to::MarkerTracker(v, {.max_step = max_step});
+             return to::MarkerTracker(dots_from(dots), {.max_step = max_step});
            }),
            py::arg("dots"), py::kw_only(), py::arg("max_step") = 0.0,
            "Tracks for the dots of the reference frame (find_dots' array); `max_step` 0: 0.4 "
@@ -336,11 +341,7 @@ field: lost dots are placed by their neighbours' motion, new dots start new trac
       .def(
           "update",
           [](to::MarkerTracker& t, const ArrayD& dots) {
-            require_shape(dots, {-1, 3}, "dots", "(dots, 3)");
-            std::vector<to::Dot> v;
-            for (py::ssize_t i = 0; i < dots.shape(0); ++i) {
-              v.push_back({dots.at(i, 0), dots.at(i, 1), dots.at(i, 2)});
-            }
+            const std::vector<to::Dot> v = dots_from(dots);
             py::gil_scoped_release release;
             const auto lock = write_lock(&t);
             return t.update(v);

@@ -193,27 +193,11 @@ void track_background(Calibration& cal, const RgbFrame& frame, const HeightMap& 
   if (!(rate > 0 && rate <= 1) || margin < 0) {
     throw std::invalid_argument("track_background: rate in (0, 1] and margin >= 0 are needed");
   }
-  // The untouched pixels: outside the mask grown by `margin` (a square reach, by a separable
-  // running maximum of the mask).
+  // The untouched pixels: outside the mask grown by `margin` (a square reach: the running
+  // maximum of the mask, as the marker search's).
   const auto rows = static_cast<int>(cal.rows), cols = static_cast<int>(cal.cols);
-  Plane near(rows, cols);
-  std::vector<double> line, g, h, out;
-  for (int r = 0; r < rows; ++r) {
-    line.resize(static_cast<std::size_t>(cols));
-    for (int c = 0; c < cols; ++c) line[static_cast<std::size_t>(c)] = map.mask(r, c) ? 1.0 : 0.0;
-    if (margin > 0) {
-      detail::running_max(line, margin, g, h, out);
-    } else {
-      out = line;
-    }
-    for (int c = 0; c < cols; ++c) near(r, c) = out[static_cast<std::size_t>(c)];
-  }
-  for (int c = 0; c < cols && margin > 0; ++c) {
-    line.resize(static_cast<std::size_t>(rows));
-    for (int r = 0; r < rows; ++r) line[static_cast<std::size_t>(r)] = near(r, c);
-    detail::running_max(line, margin, g, h, out);
-    for (int r = 0; r < rows; ++r) near(r, c) = out[static_cast<std::size_t>(r)];
-  }
+  const Plane mask = map.mask.cast<double>();
+  const Plane near = margin > 0 ? detail::running_max_2d(mask, margin) : mask;
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       if (near(r, c) > 0) continue;
