@@ -79,6 +79,18 @@ inline std::vector<int> class_order(std::span<const int> y) {
   return labels;
 }
 
+namespace detail {
+/// "" when `classes` are distinct (as a model read from bytes must hold them), else the problem.
+inline std::string classes_error(std::span<const int> classes) {
+  for (std::size_t i = 0; i < classes.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (classes[i] == classes[j]) return "label " + std::to_string(classes[i]) + " twice";
+    }
+  }
+  return {};
+}
+}  // namespace detail
+
 /// Position of `label` in `classes`, or -1.
 inline int class_index(std::span<const int> classes, int label) noexcept {
   for (std::size_t c = 0; c < classes.size(); ++c) {

@@ -88,6 +88,32 @@ class Knn {
   /// Number of features a sample has; 0 before fit (Classifier).
   [[nodiscard]] Eigen::Index dims() const noexcept { return x_.cols(); }
 
+  /// Visits the options and the training set (encode_model / decode_model in model_file.hpp).
+  template <class Ar>
+  void state(Ar& ar) {
+    ar.value(cfg_.k, "k");
+    ar.enumeration(cfg_.metric, 2, "metric");
+    ar.enumeration(cfg_.weighting, 2, "weighting");
+    ar.vector(classes_, "classes");
+    ar.matrix(x_, "training samples");
+    ar.vector(cls_, "training classes");
+    ar.verify([&]() -> std::string {
+      (void)Knn(cfg_);
+      std::string e = detail::classes_error(classes_);
+      if (!e.empty()) return e;
+      if (static_cast<std::size_t>(x_.rows()) != cls_.size())
+        return "training samples and classes disagree";
+      if (x_.rows() > 0 && (x_.rows() < cfg_.k || classes_.empty()))
+        return "fewer training samples than k";
+      for (int c : cls_) {
+        if (c < 0 || static_cast<std::size_t>(c) >= classes_.size())
+          return "a training class out of range";
+      }
+      return {};
+    });
+    sq_ = x_.rowwise().squaredNorm();
+  }
+
  private:
   // Fills votes per class; returns the class of the nearest neighbour.
   template <class D = void>

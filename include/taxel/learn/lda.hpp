@@ -134,6 +134,28 @@ class Lda {
   /// The shrinkage used by the last fit (the Ledoit-Wolf estimate when automatic).
   [[nodiscard]] double shrinkage() const noexcept { return shrinkage_; }
 
+  /// Visits the options and what fit learned (encode_model / decode_model in model_file.hpp).
+  template <class Ar>
+  void state(Ar& ar) {
+    ar.value(cfg_.shrinkage, "shrinkage");
+    ar.value(cfg_.empirical_priors, "empirical_priors");
+    ar.vector(classes_, "classes");
+    ar.matrix(w_, "weights");
+    ar.matrix(b_, "offsets");
+    ar.matrix(means_, "means");
+    ar.value(shrinkage_, "fitted shrinkage");
+    ar.verify([&]() -> std::string {
+      (void)Lda(cfg_);
+      std::string e = detail::classes_error(classes_);
+      if (!e.empty()) return e;
+      const auto k = static_cast<Eigen::Index>(classes_.size());
+      if (w_.rows() != k || b_.size() != k ||
+          (k > 0 && (means_.rows() != k || means_.cols() != w_.cols())))
+        return "classes, weights, offsets and means disagree";
+      return {};
+    });
+  }
+
  private:
   LdaConfig cfg_;
   std::vector<int> classes_;

@@ -346,6 +346,48 @@ class LinearSvm {
     return m;
   }
 
+  /// Visits the options, the weights and the training record (encode_model / decode_model in
+  /// model_file.hpp).
+  template <class Ar>
+  void state(Ar& ar) {
+    ar.enumeration(cfg_.loss, 2, "loss");
+    ar.value(cfg_.C, "C");
+    ar.value(cfg_.eps, "eps");
+    ar.value(cfg_.bias, "bias");
+    ar.value(cfg_.max_iterations, "max_iterations");
+    ar.value(cfg_.shrinking, "shrinking");
+    ar.value(cfg_.seed, "seed");
+    ar.value(cfg_.record_objective, "record_objective");
+    ar.pairs(cfg_.class_weights, "class_weights");
+    ar.value(cfg_.threads, "threads");
+    ar.vector(classes_, "classes");
+    ar.matrix(w_, "weights");
+    ar.matrix(wb_, "bias weights");
+    ar.value(bias_, "fitted bias");
+    ar.vector(info_.iterations, "iterations");
+    ar.vector(info_.objective, "objective");
+    ar.vector(info_.support_vectors, "support vectors");
+    ar.nested(info_.trace, "objective trace");
+    ar.text(solver_, "solver");
+    ar.value(multiclass_cs_, "multiclass_cs");
+    ar.verify([&]() -> std::string {
+      (void)LinearSvm(cfg_);
+      std::string e = detail::classes_error(classes_);
+      if (!e.empty()) return e;
+      static constexpr std::string_view kKnown[] = {
+          "L2R_LR",   "L2R_L2LOSS_SVC_DUAL", "L2R_L2LOSS_SVC", "L2R_L1LOSS_SVC_DUAL",
+          "MCSVM_CS", "L1R_L2LOSS_SVC",      "L1R_LR",         "L2R_LR_DUAL"};
+      if (std::find(std::begin(kKnown), std::end(kKnown), solver_) == std::end(kKnown))
+        return "unknown solver " + solver_;
+      const std::size_t k = classes_.size();
+      if (k == 0) return w_.size() + wb_.size() == 0 ? "" : "weights without classes";
+      const auto nr = static_cast<Eigen::Index>(k == 2 && !multiclass_cs_ ? 1 : k);
+      if (k < 2 || w_.rows() != nr || wb_.size() != nr || w_.cols() < 1)
+        return "classes and weights disagree";
+      return {};
+    });
+  }
+
  private:
   struct Solve {
     int iterations = 0;

@@ -186,6 +186,43 @@ class Mlp {
   /// Best mean training cross-entropy of the last fit.
   [[nodiscard]] double loss() const noexcept { return loss_; }
 
+  /// Visits the options and the weights (encode_model / decode_model in model_file.hpp).
+  template <class Ar>
+  void state(Ar& ar) {
+    ar.vector(cfg_.hidden, "hidden");
+    ar.enumeration(cfg_.activation, 2, "activation");
+    ar.enumeration(cfg_.optimizer, 2, "optimizer");
+    ar.value(cfg_.learning_rate, "learning_rate");
+    ar.value(cfg_.momentum, "momentum");
+    ar.value(cfg_.l2, "l2");
+    ar.value(cfg_.epochs, "epochs");
+    ar.value(cfg_.batch_size, "batch_size");
+    ar.value(cfg_.tolerance, "tolerance");
+    ar.value(cfg_.patience, "patience");
+    ar.value(cfg_.seed, "seed");
+    ar.vector(classes_, "classes");
+    ar.matrices(w_, "weights");
+    ar.matrices(b_, "biases");
+    ar.value(epochs_, "epochs run");
+    ar.value(loss_, "loss");
+    ar.verify([&]() -> std::string {
+      (void)Mlp(cfg_);
+      std::string e = detail::classes_error(classes_);
+      if (!e.empty()) return e;
+      if (w_.empty() && b_.empty()) return classes_.empty() ? "" : "classes without weights";
+      if (w_.size() != cfg_.hidden.size() + 1 || b_.size() != w_.size())
+        return "the layers disagree with hidden";
+      for (std::size_t l = 0; l < w_.size(); ++l) {
+        const Eigen::Index out =
+            l + 1 < w_.size() ? cfg_.hidden[l] : static_cast<Eigen::Index>(classes_.size());
+        if (w_[l].rows() != out || b_[l].size() != out || w_[l].cols() < 1 ||
+            (l > 0 && w_[l].cols() != w_[l - 1].rows()))
+          return "layer " + std::to_string(l) + "'s sizes disagree";
+      }
+      return {};
+    });
+  }
+
  private:
   template <class M>
   [[nodiscard]] M activate(const M& z) const {

@@ -196,6 +196,42 @@ class RbfSvm {
   /// SMO iterations of each pair problem in the last fit.
   [[nodiscard]] std::span<const long long> iterations() const noexcept { return iterations_; }
 
+  /// Visits the options and the support vectors (encode_model / decode_model in
+  /// model_file.hpp).
+  template <class Ar>
+  void state(Ar& ar) {
+    ar.value(cfg_.C, "C");
+    ar.value(cfg_.gamma, "gamma");
+    ar.value(cfg_.eps, "eps");
+    ar.value(cfg_.cache_mb, "cache_mb");
+    ar.value(cfg_.max_iterations, "max_iterations");
+    ar.vector(classes_, "classes");
+    ar.matrix(sv_, "support vectors");
+    ar.matrix(coef_, "coefficients");
+    ar.vector(sv_class_, "support vector classes");
+    ar.vector(rho_, "rho");
+    ar.vector(iterations_, "iterations");
+    ar.value(gamma_, "fitted gamma");
+    ar.verify([&]() -> std::string {
+      (void)RbfSvm(cfg_);
+      std::string e = detail::classes_error(classes_);
+      if (!e.empty()) return e;
+      const std::size_t k = classes_.size();
+      if (k == 0) return sv_.size() + coef_.size() + rho_.size() == 0 ? "" : "no classes";
+      if (k < 2 || !(gamma_ > 0.0)) return "a fitted model needs two classes and gamma > 0";
+      if (coef_.rows() != sv_.rows() || coef_.cols() != static_cast<Eigen::Index>(k - 1) ||
+          sv_class_.size() != static_cast<std::size_t>(sv_.rows()) ||
+          rho_.size() != k * (k - 1) / 2)
+        return "support vectors, coefficients and rho disagree";
+      for (int c : sv_class_) {
+        if (c < 0 || static_cast<std::size_t>(c) >= k)
+          return "a support vector's class is out of range";
+      }
+      return {};
+    });
+    sv_sq_ = sv_.rowwise().squaredNorm();
+  }
+
  private:
   struct Binary {
     std::vector<double> alpha;

@@ -32,6 +32,7 @@
 #include <string_view>
 
 #include "taxel/core/error.hpp"
+#include "taxel/io/binary.hpp"
 #include "taxel/io/file.hpp"
 #include "taxel/optical/calibration.hpp"
 
@@ -40,68 +41,41 @@ namespace taxel::optical {
 namespace detail {
 inline constexpr char kCalMagic[8] = {'T', 'X', 'O', 'C', 'A', 'L', 0, 1};
 
-template <class T>
-void put(std::string& out, T v) {
-  static_assert(std::endian::native == std::endian::little, "little-endian hosts only");
-  char b[sizeof(T)];
-  std::memcpy(b, &v, sizeof(T));
-  out.append(b, sizeof(T));
-}
-
-struct CalReader {
-  std::string_view bytes;
-  std::string source;
-  std::size_t at = 0;
-  template <class T>
-  T get(const char* what) {
-    if (bytes.size() - at < sizeof(T)) {
-      throw IoError(source, std::string("cut short in ") + what, std::nullopt, at);
-    }
-    T v;
-    std::memcpy(&v, bytes.data() + at, sizeof(T));
-    at += sizeof(T);
-    return v;
-  }
-  double finite(const char* what) {
-    const double v = get<double>(what);
-    if (!std::isfinite(v))
-      throw IoError(source, std::string(what) + " is not finite", std::nullopt, at - 8);
-    return v;
-  }
-};
+using io::put_le;
+using CalReader = io::BinaryReader;
 }  // namespace detail
 
 /// A calibration's file bytes (see the header comment).
 template <class = void>
 std::string encode_calibration(const Calibration& cal) {
   std::string out(detail::kCalMagic, 8);
-  detail::put<std::int32_t>(out, cal.rows);
-  detail::put<std::int32_t>(out, cal.cols);
-  detail::put<double>(out, cal.pixel);
-  detail::put<double>(out, cal.threshold);
-  detail::put<std::uint8_t>(out, cal.method == Calibration::Method::polynomial ? 0 : 1);
-  detail::put<std::uint8_t>(out, cal.markers ? 1 : 0);
-  detail::put<double>(out, cal.marker.dark);
-  detail::put<std::int32_t>(out, cal.marker.reach);
-  detail::put<std::int32_t>(out, cal.marker.grow);
-  detail::put<double>(out, cal.heldout_polynomial);
-  detail::put<double>(out, cal.heldout_table);
-  detail::put<std::uint32_t>(out, static_cast<std::uint32_t>(cal.circles.size()));
+  detail::put_le<std::int32_t>(out, cal.rows);
+  detail::put_le<std::int32_t>(out, cal.cols);
+  detail::put_le<double>(out, cal.pixel);
+  detail::put_le<double>(out, cal.threshold);
+  detail::put_le<std::uint8_t>(out, cal.method == Calibration::Method::polynomial ? 0 : 1);
+  detail::put_le<std::uint8_t>(out, cal.markers ? 1 : 0);
+  detail::put_le<double>(out, cal.marker.dark);
+  detail::put_le<std::int32_t>(out, cal.marker.reach);
+  detail::put_le<std::int32_t>(out, cal.marker.grow);
+  detail::put_le<double>(out, cal.heldout_polynomial);
+  detail::put_le<double>(out, cal.heldout_table);
+  detail::put_le<std::uint32_t>(out, static_cast<std::uint32_t>(cal.circles.size()));
   for (const Circle& c : cal.circles) {
-    detail::put<double>(out, c.cx);
-    detail::put<double>(out, c.cy);
-    detail::put<double>(out, c.radius);
+    detail::put_le<double>(out, c.cx);
+    detail::put_le<double>(out, c.cy);
+    detail::put_le<double>(out, c.radius);
   }
   const RgbFrame bg = to_frame(cal.background);
   out.append(reinterpret_cast<const char*>(bg.data.data()), bg.data.size());
-  detail::put<std::uint32_t>(out, static_cast<std::uint32_t>(cal.polynomial.rows()));
+  detail::put_le<std::uint32_t>(out, static_cast<std::uint32_t>(cal.polynomial.rows()));
   for (Eigen::Index r = 0; r < cal.polynomial.rows(); ++r) {
-    detail::put<double>(out, cal.polynomial(r, 0));
-    detail::put<double>(out, cal.polynomial(r, 1));
+    detail::put_le<double>(out, cal.polynomial(r, 0));
+    detail::put_le<double>(out, cal.polynomial(r, 1));
   }
-  detail::put<std::int32_t>(out, cal.table.empty() ? 0 : cal.table_bins);
-  detail::put<double>(out, cal.table_range);
-  for (const float v : cal.table) detail::put<float>(out, v);
+  detail::put_le<std::int32_t>(out, cal.table.empty() ? 0 : cal.table_bins);
+  detail::put_le<double>(out, cal.table_range);
+  for (const float v : cal.table) detail::put_le<float>(out, v);
   return out;
 }
 
