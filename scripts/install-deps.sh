@@ -8,7 +8,7 @@ what=${1:-test}
 pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev nlohmann-json3-dev)
 # The Python module, and what its tests and examples compare with or plot through.
 python=(pybind11-dev python3-dev python3-numpy python3-venv python3-setuptools python3-pip)
-python_test=(python3-pytest python3-scipy python3-skimage python3-matplotlib)
+python_test=(python3-pytest python3-scipy python3-skimage python3-matplotlib python3-sklearn mypy)
 case "$what" in
   build) ;;
   test) pkgs+=(catch2 libbenchmark-dev robin-map-dev libusb-1.0-0-dev libpng-dev libjpeg-dev liblinear-dev liblinear-tools libsvm-dev umockdev libumockdev-dev chromium doxygen python3-markdown "${python[@]}" "${python_test[@]}") ;;

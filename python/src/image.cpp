@@ -201,32 +201,58 @@ counter-clockwise with y up.)doc");
       .def_readonly("pixel_max", &im::Segmentation::pixel_max)
       .def_readonly("pixel_mean", &im::Segmentation::pixel_mean);
 
+  // One body for segment (an image) and segment_stack (frames): every frame segmented by one
+  // Segmenter, the GIL released per frame.
+  const auto segment_frames = [](const ArrayD& image, const Frames& f, int k,
+                                 const std::string& polarity, int min_area, int connectivity,
+                                 int histogram_levels) {
+    im::Segmenter seg(segmentation_config(k, polarity, min_area, connectivity, histogram_levels),
+                      f.rows, f.cols);
+    std::vector<im::Segmentation> out;
+    for (py::ssize_t i = 0; i < f.frames; ++i) {
+      {
+        py::gil_scoped_release release;
+        out.push_back(seg.run(frame(image, f, i)));
+      }
+      if (!out.back().ok()) {
+        throw py::value_error((f.stacked ? "frame " + std::to_string(i) + ": " : "") +
+                              out.back().message);
+      }
+    }
+    return out;
+  };
   m.def(
       "segment",
-      [](const ArrayD& image, int k, const std::string& polarity, int min_area, int connectivity,
-         int histogram_levels) -> py::object {
-        const Frames f = frames_of(image, "segment");
-        im::Segmenter seg(
-            segmentation_config(k, polarity, min_area, connectivity, histogram_levels), f.rows,
-            f.cols);
-        std::vector<im::Segmentation> out;
-        for (py::ssize_t i = 0; i < f.frames; ++i) {
-          {
-            py::gil_scoped_release release;
-            out.push_back(seg.run(frame(image, f, i)));
-          }
-          if (!out.back().ok()) {
-            throw py::value_error((f.stacked ? "frame " + std::to_string(i) + ": " : "") +
-                                  out.back().message);
-          }
+      [segment_frames](const ArrayD& image, int k, const std::string& polarity, int min_area,
+                       int connectivity, int histogram_levels) {
+        if (image.ndim() == 3) {
+          throw py::value_error("segment: expected one image (rows, cols), got a stack " +
+                                shape_text(image) + "; use segment_stack for frames");
         }
-        if (!f.stacked) return py::cast(std::move(out.front()));
-        return py::cast(std::move(out));
+        const Frames f = frames_of(image, "segment");
+        return std::move(
+            segment_frames(image, f, k, polarity, min_area, connectivity, histogram_levels)
+                .front());
       },
       py::arg("image"), py::kw_only(), py::arg("k") = 3, py::arg("polarity") = "high_is_pressure",
       py::arg("min_area") = 50, py::arg("connectivity") = 8, py::arg("histogram_levels") = 65536,
-      "Segments an image (a Segmentation) or a stack (a list): k-means of the pixel values, "
-      "the top cluster's 8-connected regions of at least min_area pixels are the HPR.");
+      "Segments an image (rows, cols): k-means of the pixel values; the top cluster's "
+      "8-connected regions of at least min_area pixels are the HPR.");
+  m.def(
+      "segment_stack",
+      [segment_frames](const ArrayD& images, int k, const std::string& polarity, int min_area,
+                       int connectivity, int histogram_levels) {
+        if (images.ndim() != 3) {
+          throw py::value_error("segment_stack: expected a stack (frames, rows, cols), got " +
+                                shape_text(images) + "; use segment for one image");
+        }
+        return segment_frames(images, frames_of(images, "segment_stack"), k, polarity, min_area,
+                              connectivity, histogram_levels);
+      },
+      py::arg("images"), py::kw_only(), py::arg("k") = 3, py::arg("polarity") = "high_is_pressure",
+      py::arg("min_area") = 50, py::arg("connectivity") = 8, py::arg("histogram_levels") = 65536,
+      "Segments each frame of a stack (frames, rows, cols) as segment does: a list of "
+      "Segmentation.");
 
   m.def(
       "label",

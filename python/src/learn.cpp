@@ -5,6 +5,7 @@
 #include "common.hpp"
 #include "taxel/io/file.hpp"
 #include "taxel/io/libsvm_format.hpp"
+#include "taxel/learn/model_file.hpp"
 
 namespace taxel::python {
 namespace {
@@ -159,10 +160,50 @@ py::class_<C> bind_classifier(py::module_& m, const char* name, const char* doc)
             return vector_array(std::vector<int>(cl.begin(), cl.end()));
           },
           "labels in the model's order")
-      .def_property_readonly("n_features_in_", [](const C& c) {
-        const auto lock = read_lock(&c);
-        return c.dims();
-      });
+      .def_property_readonly("n_features_in_",
+                             [](const C& c) {
+                               const auto lock = read_lock(&c);
+                               return c.dims();
+                             })
+      .def(
+          "to_bytes",
+          [](const C& c) {
+            std::string bytes;
+            {
+              const auto lock = read_lock(&c);
+              bytes = ln::encode_model(c);
+            }
+            return py::bytes(bytes);
+          },
+          "The model (options, classes, what it learned) as taxel's versioned model bytes.")
+      .def_static(
+          "from_bytes",
+          [](const py::bytes& b, const std::string& source) {
+            return ln::decode_model<C>(
+                std::string_view(b),
+                source.empty() ? std::string(name_of<C>()) + " bytes" : source);
+          },
+          py::arg("data"), py::arg("source") = "",
+          "A model from to_bytes(); taxel.IoError naming `source` for damaged bytes.")
+      .def(py::pickle(
+          [](const C& c) {
+            const auto lock = read_lock(&c);
+            return py::make_tuple(py::bytes(ln::encode_model(c)));
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 1 || !py::isinstance<py::bytes>(t[0])) {
+              throw py::value_error(std::string(name_of<C>()) + ": not a pickled model state");
+            }
+            return ln::decode_model<C>(std::string_view(t[0].cast<py::bytes>()),
+                                       std::string("pickled ") + name_of<C>());
+          }))
+      .def(
+          "__deepcopy__",
+          [](const C& c, const py::dict&) {
+            const auto lock = read_lock(&c);
+            return C(c);
+          },
+          py::arg("memo"));
   return cls;
 }
 
@@ -228,6 +269,13 @@ files.)doc");
           },
           "(n_problems,) intercepts: bias * bias weight")
       .def_property_readonly("solver_type", &ln::LinearSvm::solver_type)
+      .def_property_readonly(
+          "bias",
+          [](const ln::LinearSvm& s) {
+            const auto lock = read_lock(&s);
+            return s.bias();
+          },
+          "the bias feature's value the model was trained with (< 0: none)")
       .def_property_readonly("iterations",
                              [](const ln::LinearSvm& s) {
                                const auto lock = read_lock(&s);
@@ -283,7 +331,33 @@ files.)doc");
                  return ln::RbfSvm(ln::RbfSvmConfig{C, gamma, eps, cache_mb, max_iterations});
                }),
            py::kw_only(), py::arg("C") = 1.0, py::arg("gamma") = 0.0, py::arg("eps") = 1e-3,
-           py::arg("cache_mb") = 100.0, py::arg("max_iterations") = 0);
+           py::arg("cache_mb") = 100.0, py::arg("max_iterations") = 0)
+      .def(
+          "pair_decision_function",
+          [](const ln::RbfSvm& c, const ArrayD& x) {
+            const auto lock = read_lock(&c);
+            if (c.dims() == 0) throw py::value_error("RbfSvm: not fitted");
+            require_shape(x, {-1, c.dims()}, "X", "(n_samples, n_features)");
+            const auto k = static_cast<py::ssize_t>(c.classes().size());
+            ArrayD out({x.shape(0), k * (k - 1) / 2});
+            py::gil_scoped_release release;
+            for (py::ssize_t i = 0; i < x.shape(0); ++i) {
+              Eigen::Map<Eigen::VectorXd> row(out.mutable_data() + i * out.shape(1), out.shape(1));
+              c.pair_decision(Eigen::Map<const Eigen::VectorXd>(x.data() + i * c.dims(), c.dims()),
+                              row);
+            }
+            return out;
+          },
+          py::arg("X"),
+          "(n_samples, k (k - 1) / 2) raw one-vs-one values, LIBSVM's pair order (0, 1), "
+          "(0, 2), ..., (1, 2), ...; positive favours the pair's first class in classes_.")
+      .def_property_readonly(
+          "support_vectors_",
+          [](const ln::RbfSvm& c) {
+            const auto lock = read_lock(&c);
+            return ln::FeatureMatrix(c.support_vectors());
+          },
+          "(n_support, n_features) support vectors, in training order");
 
   bind_classifier<ln::Mlp>(m, "Mlp",
                            "Multi-layer perceptron (one or two hidden layers, softmax output); "

@@ -17,6 +17,12 @@ import taxel.sensor
 import taxel.sim
 
 
+class InsertResult(typing.TypedDict):
+    added: int
+    fused: int
+    rejected: int
+
+
 class ContactCloud:
     """A compact cloud of fused contact points (Meier et al. 2011): each contact fuses into the
 nearest point within `association_radius` [m], or starts a new point. The gate widens to
@@ -39,11 +45,11 @@ Options that the chosen policy or index does not use must stay at their defaults
     @property
     def index(self) -> str: ...
     @typing.overload
-    def insert(self, positions: numpy.typing.NDArray[numpy.float64], covariances: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, normals: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, pressures: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, times: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, *, sigma: typing.Optional[float] = None, footprint_sigma: float = 0.0, strict: bool = True) -> dict: ...
+    def insert(self, positions: numpy.typing.NDArray[numpy.float64], covariances: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, normals: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, pressures: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, times: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, *, sigma: typing.Optional[float] = None, footprint_sigma: float = 0.0, strict: bool = True) -> taxel.fusion.InsertResult: ...
     @typing.overload
-    def insert(self, contacts: taxel.Contacts) -> dict: ...
+    def insert(self, contacts: taxel.Contacts) -> taxel.fusion.InsertResult: ...
     def insert_one(self, position: numpy.typing.NDArray[numpy.float64], sigma: float = 0.001, time: float = 0.0) -> int: """Inserts one contact with isotropic noise; returns the id of the point it added to or started."""
-    def insert_readings(self, readings: numpy.typing.NDArray[numpy.uint16], poses: numpy.typing.NDArray[numpy.float64], *, times: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, model: taxel.sensor.SensorModel = ..., options: taxel.sensor.ContactOptions = ..., frame_rate: float = 1000.0) -> dict: """Turns pad readings into contacts (taxel.sensor.contacts_from_readings) and inserts them."""
+    def insert_readings(self, readings: numpy.typing.NDArray[numpy.uint16], poses: numpy.typing.NDArray[numpy.float64], *, times: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, model: taxel.sensor.SensorModel = ..., options: taxel.sensor.ContactOptions = ..., frame_rate: float = 1000.0) -> taxel.fusion.InsertResult: """Turns pad readings into contacts (taxel.sensor.contacts_from_readings) and inserts them."""
     @property
     def last_times(self) -> numpy.typing.NDArray[numpy.float64]: ...
     @property
@@ -57,5 +63,5 @@ Options that the chosen policy or index does not use must stay at their defaults
     def reserve(self, n: int) -> None: """Makes room for n points (MemoryError when memory runs out)."""
     def to_point_cloud(self, *, min_observations: int = 1, max_sigma: float = ..., max_normal_sigma: float = ...) -> taxel.PointCloud: """The confident points as a PointCloud with fields 'observations', 'cov_xx' .. 'cov_zz', 'last_time' (and normals with the surfel policy)."""
 
-INDEXES: tuple
-POLICIES: tuple
+INDEXES: typing.Tuple[str, ...]
+POLICIES: typing.Tuple[str, ...]

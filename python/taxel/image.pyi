@@ -16,7 +16,34 @@ import taxel.registration
 import taxel.sensor
 import taxel.sim
 
-EDGE_FEATURE_NAMES: list
+
+class RegionProps(typing.TypedDict):
+    area: float
+    centroid: typing.Tuple[float, float]
+    bounding_box: typing.Tuple[float, float, float, float]
+    major_axis_length: float
+    minor_axis_length: float
+    eccentricity: float
+    orientation: float
+    convex_area: float
+    convex_hull: numpy.typing.NDArray[numpy.float64]
+    solidity: float
+    extent: float
+    equiv_diameter: float
+    euler_number: int
+    euler_number4: int
+    perimeter: float
+    label: typing.NotRequired[int]
+
+
+class ImageFeatures(typing.TypedDict):
+    regional: numpy.typing.NDArray[numpy.float64]
+    edge: numpy.typing.NDArray[numpy.float64]
+    hybrid: numpy.typing.NDArray[numpy.float64]
+    edged: numpy.typing.NDArray[numpy.float64]
+    contour_gradient: numpy.typing.NDArray[numpy.float64]
+
+EDGE_FEATURE_NAMES: typing.List[str]
 
 class KMeans1dResult:
     """A 1-D clustering, clusters ascending."""
@@ -42,7 +69,7 @@ class KMeans1dResult:
     @property
     def upper(self) -> typing.List[float]: ...
 
-REGIONAL_FEATURE_NAMES: list
+REGIONAL_FEATURE_NAMES: typing.List[str]
 
 class Recognition:
     """The recogniser's result for one image."""
@@ -63,7 +90,7 @@ class Recognizer:
 gradients, the edged/edgeless decision (mean contour gradient of the largest HPR above
 gradient_threshold) and the feature vectors."""
     def __init__(self, rows: int = 32, cols: int = 32, *, gradient_threshold: float = 25.0, gradient_source: str = 'raw', k: int = 3, polarity: str = 'high_is_pressure', min_area: int = 50, connectivity: int = 8) -> None: ...
-    def features(self, images: numpy.typing.NDArray[numpy.float64], *, threads: int = 0) -> dict: """Features of an image or a stack: a dict of 'regional' (F, 11), 'edge' (F, 23), 'hybrid' (F, rows*cols + 11), 'edged' (F,) and 'contour_gradient' (F,). Frames are shared out over `threads` threads (0: every core), each with its own copy of the recogniser; the result does not depend on it."""
+    def features(self, images: numpy.typing.NDArray[numpy.float64], *, threads: int = 0) -> taxel.image.ImageFeatures: """Features of an image or a stack: a dict of 'regional' (F, 11), 'edge' (F, 23), 'hybrid' (F, rows*cols + 11), 'edged' (F,) and 'contour_gradient' (F,). Frames are shared out over `threads` threads (0: every core), each with its own copy of the recogniser; the result does not depend on it."""
     def recognize(self, image: numpy.typing.NDArray[numpy.float64]) -> taxel.image.Recognition: """Runs the chain on one image; ValueError for a wrong size or NaN."""
 
 
@@ -94,20 +121,22 @@ class Segmentation:
 
 def contour(mask: numpy.typing.NDArray[numpy.uint8]) -> numpy.typing.NDArray[numpy.uint8]: """The contour pixels of a region (MATLAB's bwperim, 4-connected)."""
 
-def gradient(image: numpy.typing.NDArray[numpy.float64]) -> tuple: """(magnitude, direction): MATLAB's imgradient with Sobel kernels and replicated borders; direction in degrees in (-180, 180], counter-clockwise from +x with y up."""
+def gradient(image: numpy.typing.NDArray[numpy.float64]) -> typing.Tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]: """(magnitude, direction): MATLAB's imgradient with Sobel kernels and replicated borders; direction in degrees in (-180, 180], counter-clockwise from +x with y up."""
 
 def kmeans1d(values: numpy.typing.NDArray[numpy.float64], k: int = 3, *, method: str = 'exact', seed: int = 1, max_iterations: int = 100) -> taxel.image.KMeans1dResult: """k-means of the (flattened) values: 'exact' (globally optimal, dynamic programming) or 'lloyd' (k-means++ start). Raises ValueError for empty or non-finite values."""
 
-def label(mask: numpy.typing.NDArray[numpy.uint8], connectivity: int = 8) -> tuple: """(labels, count): connected components of the non-zero pixels, numbered from 1 in raster order (MATLAB's bwlabel numbers in column order)."""
+def label(mask: numpy.typing.NDArray[numpy.uint8], connectivity: int = 8) -> typing.Tuple[numpy.typing.NDArray[numpy.int32], int]: """(labels, count): connected components of the non-zero pixels, numbered from 1 in raster order (MATLAB's bwlabel numbers in column order)."""
 
 def rec_edged(segmentation: taxel.image.Segmentation, *, k: float = 0.5, background_fraction: float = 0.5, swap_edge_condition: bool = False, fill_whole_row: bool = False, keep_level_on_skipped_rows: bool = False, postprocess: str = 'none') -> numpy.typing.NDArray[numpy.float64]: """RecEdged: a height map from a segmentation by a row-scanning two-state machine; steps of k * high_level."""
 
 def rec_edgeless(image: numpy.typing.NDArray[numpy.float64], segmentation: taxel.image.Segmentation, *, background_fraction: float = 0.5, degree: int = 2, healing: str = 'linear', source: str = 'raw') -> numpy.typing.NDArray[numpy.float64]: """RecEdgeless: a height map from the image, gaps healed within rows and every column replaced by its least-squares polynomial of `degree`."""
 
-def region_props(mask: numpy.typing.NDArray[numpy.uint8], *, zero_based: bool = False, convex: bool = True, perimeter: bool = True) -> dict: """Descriptors of the non-zero pixels of `mask` as one region (MATLAB's regionprops of a logical image): area, centroid (x, y), bounding_box (ulx, uly, width, height) on pixel edges, major/minor_axis_length, eccentricity, orientation [deg], convex_area, convex_hull (K, 2) (x, y), solidity, extent, equiv_diameter, euler_number (8-connected objects), euler_number4, perimeter. Coordinates are 1-based unless zero_based."""
+def region_props(mask: numpy.typing.NDArray[numpy.uint8], *, zero_based: bool = False, convex: bool = True, perimeter: bool = True) -> taxel.image.RegionProps: """Descriptors of the non-zero pixels of `mask` as one region (MATLAB's regionprops of a logical image): area, centroid (x, y), bounding_box (ulx, uly, width, height) on pixel edges, major/minor_axis_length, eccentricity, orientation [deg], convex_area, convex_hull (K, 2) (x, y), solidity, extent, equiv_diameter, euler_number (8-connected objects), euler_number4, perimeter. Coordinates are 1-based unless zero_based."""
 
-def regionprops(labels: numpy.typing.NDArray[numpy.int32], *, zero_based: bool = False, convex: bool = True, perimeter: bool = True) -> list: """A dict of descriptors (see region_props) per label 1..max of a label image, with its 'label'; absent labels are skipped."""
+def regionprops(labels: numpy.typing.NDArray[numpy.int32], *, zero_based: bool = False, convex: bool = True, perimeter: bool = True) -> typing.List[taxel.image.RegionProps]: """A dict of descriptors (see region_props) per label 1..max of a label image, with its 'label'; absent labels are skipped."""
 
-def segment(image: numpy.typing.NDArray[numpy.float64], *, k: int = 3, polarity: str = 'high_is_pressure', min_area: int = 50, connectivity: int = 8, histogram_levels: int = 65536) -> typing.Union[taxel.image.Segmentation, typing.List[taxel.image.Segmentation]]: """Segments an image (a Segmentation) or a stack (a list): k-means of the pixel values, the top cluster's 8-connected regions of at least min_area pixels are the HPR."""
+def segment(image: numpy.typing.NDArray[numpy.float64], *, k: int = 3, polarity: str = 'high_is_pressure', min_area: int = 50, connectivity: int = 8, histogram_levels: int = 65536) -> taxel.image.Segmentation: """Segments an image (rows, cols): k-means of the pixel values; the top cluster's 8-connected regions of at least min_area pixels are the HPR."""
 
-def sobel(image: numpy.typing.NDArray[numpy.float64]) -> tuple: """(gx, gy): Sobel derivatives with replicated borders as MATLAB's imgradientxy; gx grows to the right, gy towards larger row indices (down)."""
+def segment_stack(images: numpy.typing.NDArray[numpy.float64], *, k: int = 3, polarity: str = 'high_is_pressure', min_area: int = 50, connectivity: int = 8, histogram_levels: int = 65536) -> typing.List[taxel.image.Segmentation]: """Segments each frame of a stack (frames, rows, cols) as segment does: a list of Segmentation."""
+
+def sobel(image: numpy.typing.NDArray[numpy.float64]) -> typing.Tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]: """(gx, gy): Sobel derivatives with replicated borders as MATLAB's imgradientxy; gx grows to the right, gy towards larger row indices (down)."""

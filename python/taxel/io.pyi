@@ -16,13 +16,20 @@ import taxel.registration
 import taxel.sensor
 import taxel.sim
 
+
+class PadPoses(typing.TypedDict):
+    frame: numpy.typing.NDArray[numpy.int64]
+    pad: numpy.typing.NDArray[numpy.int64]
+    time: numpy.typing.NDArray[numpy.float64]
+    pose: numpy.typing.NDArray[numpy.float64]
+
 def read_contacts_csv(path: str, *, strict: bool = True) -> taxel.Contacts: """Contacts from a CSV with a header (time, x, y, z and optionally the covariance, normal and pressure columns). strict=False skips bad rows with a UserWarning."""
 
 def read_image(path: str) -> numpy.typing.NDArray[typing.Any]: """A (frames, rows, cols) float64 stack from .csv (one image), .pgm (P2/P5), .npy (2-D or 3-D, any numeric dtype) or a greyscale .png."""
 
-def read_pad_poses_csv(path: str) -> dict: """Pad poses as a dict of 'frame', 'pad', 'time' (NaN where the file has none) and 'pose' (K, 4, 4) pad -> world."""
+def read_pad_poses_csv(path: str) -> taxel.io.PadPoses: """Pad poses as a dict of 'frame', 'pad', 'time' (NaN where the file has none) and 'pose' (K, 4, 4) pad -> world."""
 
-def read_ply(path: str) -> tuple: """(PointCloud, triangles (T, 3) uint32) of an ASCII or binary PLY file."""
+def read_ply(path: str) -> typing.Tuple[taxel.PointCloud, numpy.typing.NDArray[numpy.uint32]]: """(PointCloud, triangles (T, 3) uint32) of an ASCII or binary PLY file."""
 
 def write_contacts_csv(path: str, contacts: taxel.Contacts) -> None: """Writes contacts with every column."""
 

@@ -17,6 +17,14 @@ import taxel.sensor
 import taxel.sim
 
 
+class HeightMapResult(typing.TypedDict):
+    height: numpy.typing.NDArray[numpy.float64]
+    gx: numpy.typing.NDArray[numpy.float64]
+    gy: numpy.typing.NDArray[numpy.float64]
+    mask: numpy.typing.NDArray[numpy.bool_]
+    contact: numpy.typing.NDArray[numpy.bool_]
+
+
 class Calibration:
     """A map from colour change to surface slope, with the background frame it was made over, each
 press's contact circle and the held-out slope errors. Immutable; ``save`` and ``load`` keep it
@@ -48,7 +56,7 @@ class MarkerTracker:
 field: lost dots are placed by their neighbours' motion, new dots start new tracks."""
     def __init__(self, dots: numpy.typing.NDArray[numpy.float64], *, max_step: float = 0.0) -> None: """Tracks for the dots of the reference frame (find_dots' array); `max_step` 0: 0.4 times their median spacing."""
     def __repr__(self) -> str: ...
-    def field(self, rows: int, cols: int) -> tuple: """The displacement field of the last frame at every pixel, (dx, dy) [px]."""
+    def field(self, rows: int, cols: int) -> typing.Tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]: """The displacement field of the last frame at every pixel, (dx, dy) [px]."""
     @property
     def max_step(self) -> float: ...
     @property
@@ -71,8 +79,8 @@ def calibrate(presses: object, background: numpy.typing.NDArray[numpy.uint8], *,
 
 def find_dots(frame: numpy.typing.NDArray[numpy.uint8]) -> numpy.typing.NDArray[numpy.float64]: """The marker dots of a frame, (dots, 3): centre column, centre row [px] and area [px]."""
 
-def fit_ball(height: numpy.typing.NDArray[numpy.float64], contact: numpy.typing.NDArray[numpy.bool_], pixel: float) -> tuple: """The sphere through the contact's surface points: (radius [m], centre column, centre row [px]). Raises RuntimeError when the contact has fewer than 10 pixels."""
+def fit_ball(height: numpy.typing.NDArray[numpy.float64], contact: numpy.typing.NDArray[numpy.bool_], pixel: float) -> typing.Tuple[float, float, float]: """The sphere through the contact's surface points: (radius [m], centre column, centre row [px]). Raises RuntimeError when the contact has fewer than 10 pixels."""
 
 def median_background(frames: object) -> numpy.typing.NDArray[numpy.uint8]: """The per-pixel median of frames that mostly show the untouched gel, as a background."""
 
-def reconstruct(frame: numpy.typing.NDArray[numpy.uint8], calibration: taxel.optical.Calibration, *, contact_share: float = 0.3) -> dict: """One frame's height map (see Reconstructor.__call__); plans a Poisson solver each call."""
+def reconstruct(frame: numpy.typing.NDArray[numpy.uint8], calibration: taxel.optical.Calibration, *, contact_share: float = 0.3) -> taxel.optical.HeightMapResult: """One frame's height map (see Reconstructor.__call__); plans a Poisson solver each call."""

@@ -17,6 +17,20 @@ import taxel.sensor
 import taxel.sim
 
 
+class SurfaceError(typing.TypedDict):
+    signed_mean: float
+    mean: float
+    rms: float
+    max: float
+
+
+class GraspDataset(typing.TypedDict):
+    images: numpy.typing.NDArray[numpy.float64]
+    labels: numpy.typing.NDArray[numpy.int32]
+    subjects: numpy.typing.NDArray[numpy.int32]
+    right_hand: numpy.typing.NDArray[numpy.bool_]
+
+
 class Box:
     """Box of `half_extents` [m] centred at the origin, axis-aligned."""
     def __init__(self, half_extents: numpy.typing.NDArray[numpy.float64] = ...) -> None: ...
@@ -91,7 +105,7 @@ class PalmGraspSynth:
     """Synthetic palm pressure images (rows x cols, 0..255) of four grasp classes: 1 planar,
 2 one-edged, 3 two-edged, 4 cylindrical; subjects differ in hand size, finger width and force."""
     def __init__(self, rows: int = 32, cols: int = 32, *, fingers: int = 4, seed: int = 1) -> None: ...
-    def dataset(self, subjects: int, grasps: int) -> dict: """subjects x 4 classes x grasps x 2 hands images: a dict of 'images' (N, rows, cols), 'labels' (N,) 1..4, 'subjects' (N,) and 'right_hand' (N,)."""
+    def dataset(self, subjects: int, grasps: int) -> taxel.sim.GraspDataset: """subjects x 4 classes x grasps x 2 hands images: a dict of 'images' (N, rows, cols), 'labels' (N,) 1..4, 'subjects' (N,) and 'right_hand' (N,)."""
 
 
 class Sphere:
@@ -144,4 +158,4 @@ def explore_sliding(shape: object, *, slides: int = 4, frames: int = 1000, speed
 
 def icosphere(radius: float, subdivisions: int) -> taxel.sim.TriangleMesh: """A sphere mesh: an icosahedron subdivided `subdivisions` times, vertices on the sphere."""
 
-def surface_error(shape: object, points: numpy.typing.NDArray[numpy.float64], object_pose: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None) -> dict: """Distances [m] of (N, 3) points to the surface of `shape` placed at object_pose: 'signed_mean' (outside positive), 'mean' |d|, 'rms', 'max' |d|."""
+def surface_error(shape: object, points: numpy.typing.NDArray[numpy.float64], object_pose: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None) -> taxel.sim.SurfaceError: """Distances [m] of (N, 3) points to the surface of `shape` placed at object_pose: 'signed_mean' (outside positive), 'mean' |d|, 'rms', 'max' |d|."""

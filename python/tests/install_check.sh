@@ -14,6 +14,9 @@ assert taxel.__file__.startswith(sys.argv[1]), taxel.__file__
 cloud = fusion.ContactCloud("kalman")
 cloud.insert(sim.Sphere(0.03).sample_surface(500, 1).points, sigma=2e-4)
 assert 0 < len(cloud) < 500
+from taxel import learn
+x = np.random.default_rng(1).normal(size=(40, 3)); y = np.arange(40) % 2; x[y == 1] += 3
+assert learn.LinearSvm().fit(x, y).score(x, y) > 0.9
 print("taxel", taxel.__version__, "from", taxel.__file__, ":", cloud)
 '
 case "$how" in

@@ -132,8 +132,12 @@ def test_sobel_and_gradient_match_scipy(rng):
 def test_segmentation_and_reconstruction_on_stacks():
     data = sim.PalmGraspSynth(seed=2).dataset(1, 1)
     images = data["images"]
-    segs = image.segment(images)
+    segs = image.segment_stack(images)
     assert isinstance(segs, list) and len(segs) == len(images)
+    with pytest.raises(ValueError, match="use segment_stack"):
+        image.segment(images)
+    with pytest.raises(ValueError, match="use segment for one image"):
+        image.segment_stack(images[0])
     one = image.segment(images[0])
     np.testing.assert_array_equal(one.classes, segs[0].classes)
     # The top class is the k-means cluster of the largest values.

@@ -69,7 +69,8 @@ def test_linear_svm_decision_is_linear(rng):
     d = svm.decision_function(x)
     np.testing.assert_allclose(d, x @ svm.coef_.T + svm.intercept_, atol=1e-12)
     np.testing.assert_array_equal(svm.predict(x), svm.classes_[d.argmax(axis=1)])
-    assert svm.predict(x[0]) == svm.predict(x[:1])[0]
+    with pytest.raises(ValueError, match="Reshape your data"):
+        svm.predict(x[0])
     again = learn.LinearSvm.from_liblinear(svm.to_liblinear())
     np.testing.assert_array_equal(again.coef_, svm.coef_)
 
@@ -120,9 +121,9 @@ def test_errors(tmp_path, rng):
     with pytest.raises(ValueError, match="n_samples"):
         learn.LinearSvm().fit(x, y[:-1])
     with pytest.raises(ValueError, match="C = "):
-        learn.LinearSvm(C=-1)
+        learn.LinearSvm(C=-1).fit(x, y)
     svm = learn.LinearSvm().fit(x, y)
-    with pytest.raises(ValueError, match="expected an array of shape"):
+    with pytest.raises(ValueError, match="X has 3 features, but LinearSvm is expecting 5"):
         svm.predict(x[:, :3])
     with pytest.raises(TypeError, match="classifier"):
         learn.cross_validate(object(), x, y)

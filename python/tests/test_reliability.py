@@ -41,8 +41,6 @@ def test_readings_as_whole_floats_or_wide_integers_are_read_exactly():
     [
         ([1.2, 2.7], "got 1.2"),
         ([0.1, 0.9], "got 0.1"),
-        ([2**33, 1], "got 8589934592"),
-        ([-(2**40), 1], "got -1099511627776"),
     ],
 )
 def test_labels_are_whole_numbers_in_range(y, why):
