@@ -188,6 +188,27 @@ ArrayD points_array(const Vectors& v) {
   return out;
 }
 
+/// A read-only (N, 3) array over 3-vectors held by the Python object `owner`, which the array
+/// keeps alive: no copy. Only for objects that Python cannot change (PointCloud).
+template <class Vectors>
+py::array readonly_points(const Vectors& v, py::handle owner) {
+  static_assert(sizeof(typename Vectors::value_type) == 3 * sizeof(double));
+  py::array_t<double> out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}},
+                          {py::ssize_t{3 * sizeof(double)}, py::ssize_t{sizeof(double)}},
+                          v.empty() ? nullptr : v.data()->data(), owner);
+  py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return out;
+}
+
+/// A read-only 1-D array over a vector held by `owner` (see readonly_points).
+template <class T>
+py::array readonly_vector(const std::vector<T>& v, py::handle owner) {
+  py::array_t<T> out({static_cast<py::ssize_t>(v.size())}, {py::ssize_t{sizeof(T)}}, v.data(),
+                     owner);
+  py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return out;
+}
+
 /// 3-vectors from an (N, 3) array.
 inline std::vector<Vec3d> points_from(const ArrayD& a, const char* what) {
   require_shape(a, {-1, 3}, what, "(N, 3)");

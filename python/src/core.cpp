@@ -59,6 +59,8 @@ ContactRows contact_rows(ArrayD positions, std::optional<ArrayD> covariances,
 
 namespace {
 
+constexpr py::ssize_t kContactRow = 20;  // doubles per contact in a pickled Contacts
+
 ArrayD covariances_array(const ContactList& cs) {
   ArrayD out({static_cast<py::ssize_t>(cs.size()), py::ssize_t{3}, py::ssize_t{3}});
   double* p = out.mutable_data();
@@ -84,8 +86,10 @@ void bind_core(py::module_& m) {
   py::class_<Cloud>(m, "PointCloud", R"doc(
 Points [m] with optional unit normals and named per-point scalar fields.
 
-Arrays are copied in and out: ``cloud.points`` is an (N, 3) float64 array, ``cloud.normals``
-an (N, 3) array or None, ``cloud.fields`` a dict of (N,) arrays.)doc")
+Arrays are copied in. Out, ``cloud.points`` (N, 3), ``cloud.normals`` (N, 3) or None and the
+(N,) arrays of ``cloud.fields`` are read-only views of the cloud's memory (no copy; each keeps
+the cloud alive). A PointCloud never changes once made, so the views stay valid; copy one
+(``np.array(cloud.points)``) to change it. Clouds pickle and deep-copy.)doc")
       .def(py::init([](ArrayD points, std::optional<ArrayD> normals,
                        std::optional<std::map<std::string, ArrayD>> fields) {
              Cloud c = cloud_from(points, normals, "points");
@@ -102,22 +106,58 @@ an (N, 3) array or None, ``cloud.fields`` a dict of (N,) arrays.)doc")
            py::arg("points"), py::arg("normals") = py::none(), py::arg("fields") = py::none())
       .def("__len__", &Cloud::size)
       .def_property_readonly(
-          "points", [](const Cloud& c) { return points_array(c.points); }, "(N, 3) positions [m]")
+          "points",
+          [](const py::object& self) -> ArrayD {
+            return readonly_points(self.cast<const Cloud&>().points, self);
+          },
+          "(N, 3) positions [m], a read-only view")
       .def_property_readonly(
           "normals",
-          [](const Cloud& c) -> std::optional<ArrayD> {
+          [](const py::object& self) -> std::optional<ArrayD> {
+            const Cloud& c = self.cast<const Cloud&>();
             if (!c.has_normals()) return std::nullopt;
-            return points_array(c.normals);
+            return ArrayD(readonly_points(c.normals, self));
           },
-          "(N, 3) unit normals, or None")
+          "(N, 3) unit normals, a read-only view, or None")
       .def_property_readonly(
           "fields",
-          [](const Cloud& c) {
-            std::map<std::string, py::array_t<double>> out;
-            for (const auto& f : c.fields) out[f.name] = vector_array(f.values);
+          [](const py::object& self) {
+            std::map<std::string, ArrayD> out;
+            for (const auto& f : self.cast<const Cloud&>().fields) {
+              out[f.name] = readonly_vector(f.values, self);
+            }
             return out;
           },
-          "per-point scalars by name")
+          "per-point scalars by name, each a read-only (N,) view")
+      .def(py::pickle(
+          [](const py::object& self) {
+            const Cloud& c = self.cast<const Cloud&>();
+            py::dict fields;
+            for (const auto& f : c.fields) fields[py::str(f.name)] = vector_array(f.values);
+            return py::make_tuple(
+                1, points_array(c.points),
+                c.has_normals() ? py::object(points_array(c.normals)) : py::none(), fields);
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 4 || t[0].cast<int>() != 1) {
+              throw py::value_error("PointCloud: not a pickled state of version 1");
+            }
+            Cloud c = cloud_from(t[1].cast<ArrayD>(),
+                                 t[2].is_none() ? std::optional<ArrayD>{} : t[2].cast<ArrayD>(),
+                                 "points");
+            for (const auto& [name, values] : t[3].cast<py::dict>()) {
+              const auto v = values.cast<ArrayD>();
+              require_shape(v, {static_cast<py::ssize_t>(c.size())}, "a pickled field",
+                            "(N,) like points");
+              c.fields.push_back(
+                  {name.cast<std::string>(), std::vector<double>(v.data(), v.data() + v.size())});
+            }
+            return c;
+          }))
+      .def("__copy__", [](const py::object& self) { return self; })
+      .def(
+          "__deepcopy__", [](const py::object& self, const py::dict&) { return self; },
+          py::arg("memo"))
       .def("__repr__", [](const Cloud& c) {
         return "PointCloud(" + std::to_string(c.size()) + " points" +
                (c.has_normals() ? ", normals" : "") +
@@ -186,6 +226,48 @@ the C++ loop with no conversion.)doc")
           "(N,) angular standard deviations of the normals [rad]; 0 where not stated")
       .def_property_readonly("footprint_sigmas", &contact_column<&Contact<double>::footprint_sigma>,
                              "(N,) footprints across the normals [m]; 0: all scatter")
+      .def(py::pickle(
+          [](const ContactList& cs) {
+            // Version 1: one row of 20 per contact: position (3), covariance (9, row-major),
+            // has a normal (1), normal (3), pressure, time, normal_sigma, footprint_sigma.
+            ArrayD rows({static_cast<py::ssize_t>(cs.size()), py::ssize_t{kContactRow}});
+            double* p = rows.mutable_data();
+            for (const auto& c : cs) {
+              store(p, c.position);
+              store(p + 3, c.covariance);
+              p[12] = c.normal ? 1.0 : 0.0;
+              store(p + 13, c.normal.value_or(Vec3d::Zero()));
+              p[16] = c.pressure;
+              p[17] = c.time;
+              p[18] = c.normal_sigma;
+              p[19] = c.footprint_sigma;
+              p += kContactRow;
+            }
+            return py::make_tuple(1, rows);
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 2 || t[0].cast<int>() != 1) {
+              throw py::value_error("Contacts: not a pickled state of version 1");
+            }
+            const auto rows = t[1].cast<ArrayD>();
+            require_shape(rows, {-1, kContactRow}, "pickled contacts", "(N, 20)");
+            ContactList cs(static_cast<std::size_t>(rows.shape(0)));
+            const double* p = rows.data();
+            for (auto& c : cs) {
+              c.position = Eigen::Map<const Vec3d>(p);
+              c.covariance = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(p + 3);
+              if (p[12] != 0.0) c.normal = Eigen::Map<const Vec3d>(p + 13);
+              c.pressure = p[16];
+              c.time = p[17];
+              c.normal_sigma = p[18];
+              c.footprint_sigma = p[19];
+              p += kContactRow;
+            }
+            return cs;
+          }))
+      .def(
+          "__deepcopy__", [](const ContactList& cs, const py::dict&) { return ContactList(cs); },
+          py::arg("memo"))
       .def("__repr__",
            [](const ContactList& cs) { return "Contacts(" + std::to_string(cs.size()) + ")"; });
 }

@@ -51,6 +51,12 @@ class CloudBase {
   virtual void covariances(double* out) const = 0;
   virtual void observations(std::uint32_t* out) const = 0;
   virtual void last_times(double* out) const = 0;
+  /// Doubles per point state (the policy's for_each_field).
+  virtual std::size_t state_size() const = 0;
+  /// Every point's state into out[size() * state_size()].
+  virtual void states(double* out) const = 0;
+  /// Appends a point from a state written by states() (ContactCloud::restore).
+  virtual void restore(const double* state, std::uint32_t observations, double last_time) = 0;
   virtual bool confident(std::size_t id, std::uint32_t min_obs, double max_sigma,
                          double max_normal_sigma) const = 0;
   virtual Cloud to_point_cloud(std::uint32_t min_obs, double max_sigma,
@@ -94,6 +100,29 @@ class CloudImpl final : public CloudBase {
     for (std::size_t i = 0; i < cloud_.size(); ++i) {
       out[i] = cloud_.last_time(static_cast<index::PointId>(i));
     }
+  }
+  std::size_t state_size() const override {
+    std::size_t n = 0;
+    typename F::State s{};
+    F::for_each_field(s, [&](double*, std::size_t k) { n += k; });
+    return n;
+  }
+  void states(double* out) const override {
+    for (std::size_t i = 0; i < cloud_.size(); ++i) {
+      typename F::State s = cloud_.state(static_cast<index::PointId>(i));
+      F::for_each_field(s, [&](const double* v, std::size_t k) {
+        std::copy(v, v + k, out);
+        out += k;
+      });
+    }
+  }
+  void restore(const double* state, std::uint32_t observations, double last_time) override {
+    typename F::State s{};
+    F::for_each_field(s, [&](double* v, std::size_t k) {
+      std::copy(state, state + k, v);
+      state += k;
+    });
+    cloud_.restore(s, observations, last_time);
   }
   bool confident(std::size_t id, std::uint32_t min_obs, double max_sigma,
                  double max_normal_sigma) const override {
@@ -193,7 +222,32 @@ struct PyContactCloud {
   std::string policy, index;
   double association_radius;
   std::unique_ptr<CloudBase> impl;
+  CloudOptions options;  // as constructed: what a pickled cloud is made again from
 };
+
+/// A cloud of the named policy and index with options `o` (ValueError for a name or an
+/// option that does not apply).
+PyContactCloud make_cloud(const std::string& policy, const std::string& index,
+                          const CloudOptions& o) {
+  const int p = enum_from(policy, kPolicies, "policy");
+  const int i = enum_from(index, kIndexes, "index");
+  check_unused(o, p, i);
+  PyContactCloud c{policy, index, o.association_radius, nullptr, o};
+  switch (p) {
+    case 1:
+      c.impl = with_index<fusion::Kalman<double>>(i, o);
+      break;
+    case 2:
+      c.impl = with_index<fusion::Average<double>>(i, o);
+      break;
+    case 3:
+      c.impl = with_index<fusion::Raw<double>>(i, o);
+      break;
+    default:
+      c.impl = with_index<fusion::Surfel<double>>(i, o);
+  }
+  return c;
+}
 
 py::dict batch_dict(const BatchResult& r) {
   py::dict d;
@@ -393,24 +447,7 @@ Options that the chosen policy or index does not use must stay at their defaults
                  association_radius, association_sigmas,      process_noise, gate_chi2,
                  initial_sigma,      std::move(average_mode), alpha,         max_normal_angle,
                  normal_sigma,       curvature_prior,         leaf_size,     max_load_factor};
-             const int p = enum_from(policy, kPolicies, "policy");
-             const int i = enum_from(index, kIndexes, "index");
-             check_unused(o, p, i);
-             PyContactCloud c{policy, index, association_radius, nullptr};
-             switch (p) {
-               case 1:
-                 c.impl = with_index<fusion::Kalman<double>>(i, o);
-                 break;
-               case 2:
-                 c.impl = with_index<fusion::Average<double>>(i, o);
-                 break;
-               case 3:
-                 c.impl = with_index<fusion::Raw<double>>(i, o);
-                 break;
-               default:
-                 c.impl = with_index<fusion::Surfel<double>>(i, o);
-             }
-             return c;
+             return make_cloud(policy, index, o);
            }),
            py::arg("policy") = "surfel", py::arg("index") = "voxel_hash", py::kw_only(),
            py::arg("association_radius") = 3.4e-3, py::arg("association_sigmas") = 6.0,
@@ -419,6 +456,61 @@ Options that the chosen policy or index does not use must stay at their defaults
            py::arg("alpha") = 0.1, py::arg("max_normal_angle") = 1.2,
            py::arg("normal_sigma") = 0.05, py::arg("curvature_prior") = 100.0,
            py::arg("leaf_size") = 10, py::arg("max_load_factor") = 0.25)
+      .def(py::pickle(
+          [](const PyContactCloud& c) {
+            const auto lock = read_lock(&c);
+            const CloudOptions& o = c.options;
+            const auto n = static_cast<py::ssize_t>(c.impl->size());
+            const auto k = static_cast<py::ssize_t>(c.impl->state_size());
+            ArrayD states({n, k});
+            ArrayD times(n);
+            py::array_t<std::uint32_t> obs(n);
+            c.impl->states(states.mutable_data());
+            c.impl->last_times(times.mutable_data());
+            c.impl->observations(obs.mutable_data());
+            const py::tuple options = py::make_tuple(
+                o.association_radius, o.association_sigmas, o.process_noise, o.gate_chi2,
+                o.initial_sigma, o.average_mode, o.alpha, o.max_normal_angle, o.normal_sigma,
+                o.curvature_prior, o.leaf_size, o.max_load_factor);
+            return py::make_tuple(1, c.policy, c.index, options, states, obs, times);
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 7 || t[0].cast<int>() != 1) {
+              throw py::value_error("ContactCloud: not a pickled state of version 1");
+            }
+            const auto ot = t[3].cast<py::tuple>();
+            if (ot.size() != 12) throw py::value_error("ContactCloud: damaged pickled options");
+            const CloudOptions o{ot[0].cast<double>(),
+                                 ot[1].cast<double>(),
+                                 ot[2].cast<double>(),
+                                 ot[3].cast<std::optional<double>>(),
+                                 ot[4].cast<std::optional<double>>(),
+                                 ot[5].cast<std::string>(),
+                                 ot[6].cast<double>(),
+                                 ot[7].cast<double>(),
+                                 ot[8].cast<double>(),
+                                 ot[9].cast<double>(),
+                                 ot[10].cast<std::size_t>(),
+                                 ot[11].cast<double>()};
+            PyContactCloud c = make_cloud(t[1].cast<std::string>(), t[2].cast<std::string>(), o);
+            const auto states = t[4].cast<ArrayD>();
+            const auto obs = t[5].cast<StrictArray<std::uint32_t>>();
+            const auto times = t[6].cast<ArrayD>();
+            const auto k = static_cast<py::ssize_t>(c.impl->state_size());
+            require_shape(states, {-1, k}, "pickled states", "(N, state size)");
+            require_shape(obs, {states.shape(0)}, "pickled observations", "(N,)");
+            require_shape(times, {states.shape(0)}, "pickled times", "(N,)");
+            c.impl->reserve(static_cast<std::size_t>(states.shape(0)));
+            try {
+              for (py::ssize_t i = 0; i < states.shape(0); ++i) {
+                c.impl->restore(states.data() + i * k, obs.data()[i], times.data()[i]);
+              }
+            } catch (const std::invalid_argument& e) {
+              throw py::value_error(std::string("ContactCloud: a pickled point is damaged: ") +
+                                    e.what());
+            }
+            return c;
+          }))
       .def_readonly("policy", &PyContactCloud::policy)
       .def_readonly("index", &PyContactCloud::index)
       .def_readonly("association_radius", &PyContactCloud::association_radius)

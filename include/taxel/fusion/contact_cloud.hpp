@@ -311,6 +311,29 @@ class ContactCloud {
     out.fields.push_back({"last_time", std::move(time)});
     return out;
   }
+  /// Appends a point with a state saved from a cloud of the same policy (`state(id)`,
+  /// `observations(id)`, `last_time(id)`), as loading a saved cloud does; the index finds it
+  /// at the state's mean. Throws std::invalid_argument for a state whose mean or covariance is
+  /// not finite, no observations, or a mean beyond what the index separates.
+  index::PointId restore(const State& state, std::uint32_t observations, double last_time) {
+    const Vec3<Scalar> mean = policy_.mean(state);
+    if (!all_finite(mean) || !all_finite(policy_.covariance(state)) || observations == 0) {
+      throw std::invalid_argument(
+          "ContactCloud::restore: a state needs a finite mean and covariance and at least one "
+          "observation");
+    }
+    if constexpr (requires(const I& ix) { ix.max_coordinate(); }) {
+      if (!(mean.cwiseAbs().maxCoeff() <= index_.max_coordinate())) {
+        throw std::invalid_argument("ContactCloud::restore: the mean is beyond the index's range");
+      }
+    }
+    TAXEL_ASSERT(points_.size() < std::numeric_limits<index::PointId>::max(),
+                 "ContactCloud: more than 2^32 - 1 points");
+    const auto id = static_cast<index::PointId>(points_.size());
+    points_.push_back({state, {observations, last_time}});
+    index_.insert(id, mean);
+    return id;
+  }
   /// Removes every point.
   void clear() {
     points_.clear();

@@ -42,6 +42,14 @@ struct Kalman {
     Vec3<S> mean;        ///< Estimated surface position [m], world frame.
     Mat3<S> covariance;  ///< Covariance of the position [m^2].
   };
+  /// Calls f(values, count) on each part of a state, in a fixed order: what a state is made
+  /// of, for saving and restoring a cloud (ContactCloud::restore).
+  template <class Fn>
+  static void for_each_field(State& s, Fn&& f) {
+    f(s.mean.data(), 3);
+    f(s.covariance.data(), 9);
+  }
+
   static constexpr bool kMerges =
       true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
 

@@ -22,6 +22,14 @@ struct Raw {
     Vec3<S> position;    ///< The contact's position [m], world frame.
     Mat3<S> covariance;  ///< Covariance of the position [m^2].
   };
+  /// Calls f(values, count) on each part of a state, in a fixed order: what a state is made
+  /// of, for saving and restoring a cloud (ContactCloud::restore).
+  template <class Fn>
+  static void for_each_field(State& s, Fn&& f) {
+    f(s.position.data(), 3);
+    f(s.covariance.data(), 9);
+  }
+
   static constexpr bool kMerges =
       false;  ///< Every contact stays a point of its own (FusionPolicy).
 

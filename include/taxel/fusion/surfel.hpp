@@ -140,6 +140,33 @@ struct Surfel {
     S kinfo[6] = {};
     Vec3<S> keta = Vec3<S>::Zero();  ///< see kinfo
   };
+  /// Calls f(values, count) on each part of a state, in a fixed order: what a state is made
+  /// of, for saving and restoring a cloud (ContactCloud::restore).
+  template <class Fn>
+  static void for_each_field(State& s, Fn&& f) {
+    for (Vec3<S>* v : {&s.origin, &s.eta, &s.n0, &s.t1, &s.t2, &s.normal_sum, &s.unit_normal}) {
+      f(v->data(), 3);
+    }
+    f(s.info, 6);
+    f(&s.count, 1);
+    f(&s.weight, 1);
+    f(&s.sz, 1);
+    f(s.su, 2);
+    f(s.suu, 3);
+    f(&s.vweight, 1);
+    f(s.vu, 2);
+    f(s.ss, 2);
+    f(s.vuu, 3);
+    f(s.ssu, 4);
+    f(s.scov, 3);
+    f(s.xinfo, 6);
+    f(s.xeta.data(), 3);
+    f(&s.xcount, 1);
+    f(s.xnormal.data(), 3);
+    f(s.sss, 3);
+    f(s.kinfo, 6);
+    f(s.keta.data(), 3);
+  }
   static constexpr bool kMerges =
       true;  ///< Contacts fuse into points (FusionPolicy; false only for Raw).
 
