@@ -209,6 +209,64 @@ py::array readonly_vector(const std::vector<T>& v, py::handle owner) {
   return out;
 }
 
+namespace detail {
+template <class V>
+py::object pickled(const V& v) {
+  if constexpr (std::is_enum_v<V>) {
+    return py::int_(static_cast<long long>(v));
+  } else if constexpr (std::is_same_v<V, Isometry3d>) {
+    return py::cast(Eigen::Matrix4d(v.matrix()));
+  } else {
+    return py::cast(v);
+  }
+}
+template <class V>
+void unpickled(V& v, const py::handle& h) {
+  if constexpr (std::is_enum_v<V>) {
+    v = static_cast<V>(h.cast<long long>());
+  } else if constexpr (std::is_same_v<V, Isometry3d>) {
+    v.matrix() = h.cast<Eigen::Matrix4d>();
+  } else {
+    v = h.cast<V>();
+  }
+}
+}  // namespace detail
+
+/// Pickling (state: version 1, then the members in order) and deep copies for a C++ struct
+/// whose members are all listed; `name` is the class's Python name, for errors.
+template <class T, class... Ms>
+void pickle_members(py::class_<T>& cls, const char* name, Ms... members) {
+  cls.def(py::pickle(
+      [members...](const T& t) { return py::make_tuple(1, detail::pickled(t.*members)...); },
+      [members..., name](const py::tuple& s) {
+        if (s.size() != sizeof...(Ms) + 1 || s[0].cast<int>() != 1) {
+          throw py::value_error(std::string(name) + ": not a pickled state of version 1");
+        }
+        T t{};
+        std::size_t i = 1;
+        (detail::unpickled(t.*members, s[i++]), ...);
+        return t;
+      }));
+  cls.def(
+      "__deepcopy__", [](const T& t, const py::dict&) { return T(t); }, py::arg("memo"));
+}
+
+/// Pickling through a constructor: `args(t)` gives the arguments as a tuple, `make(tuple)`
+/// builds the object again; deep copies copy.
+template <class T, class Args, class Make>
+void pickle_with(py::class_<T>& cls, const char* name, Args args, Make make) {
+  cls.def(py::pickle([args](const T& t) { return py::make_tuple(1, args(t)); },
+                     [make, name](const py::tuple& s) {
+                       if (s.size() != 2 || s[0].cast<int>() != 1) {
+                         throw py::value_error(std::string(name) +
+                                               ": not a pickled state of version 1");
+                       }
+                       return make(s[1].cast<py::tuple>());
+                     }));
+  cls.def(
+      "__deepcopy__", [](const T& t, const py::dict&) { return T(t); }, py::arg("memo"));
+}
+
 /// 3-vectors from an (N, 3) array.
 inline std::vector<Vec3d> points_from(const ArrayD& a, const char* what) {
   require_shape(a, {-1, 3}, what, "(N, 3)");

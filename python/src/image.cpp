@@ -118,7 +118,20 @@ im::SegmentationConfig segmentation_config(int k, const std::string& polarity, i
 /// The Python Recognizer: the paper's chain with the gradient-threshold edge rule.
 struct PyRecognizer {
   im::Recognizer<> recognizer;
+  py::tuple args;  // (rows, cols, gradient_threshold, gradient_source, k, polarity, min_area,
+                   // connectivity): what a pickled recogniser is made again from
 };
+
+PyRecognizer make_recognizer(py::ssize_t rows, py::ssize_t cols, double gradient_threshold,
+                             const std::string& gradient_source, int k, const std::string& polarity,
+                             int min_area, int connectivity) {
+  im::RecognizerConfig cfg;
+  cfg.segmentation = segmentation_config(k, polarity, min_area, connectivity, 65536);
+  cfg.gradient_source = enum_from(gradient_source, kGradientSources, "gradient_source");
+  return PyRecognizer{im::Recognizer<>(rows, cols, cfg, im::GradientThreshold{gradient_threshold}),
+                      py::make_tuple(rows, cols, gradient_threshold, gradient_source, k, polarity,
+                                     min_area, connectivity)};
+}
 
 }  // namespace
 
@@ -134,7 +147,14 @@ counter-clockwise with y up.)doc");
   m.attr("EDGE_FEATURE_NAMES") =
       std::vector<std::string>(im::kEdgeFeatureNames.begin(), im::kEdgeFeatureNames.end());
 
-  py::class_<im::KMeans1dResult>(m, "KMeans1dResult", "A 1-D clustering, clusters ascending.")
+  py::class_<im::KMeans1dResult> cls_kmeans1dresult(m, "KMeans1dResult",
+                                                    "A 1-D clustering, clusters ascending.");
+  pickle_members(cls_kmeans1dresult, "KMeans1dResult", &im::KMeans1dResult::status,
+                 &im::KMeans1dResult::message, &im::KMeans1dResult::k_requested,
+                 &im::KMeans1dResult::k, &im::KMeans1dResult::centroids, &im::KMeans1dResult::lower,
+                 &im::KMeans1dResult::upper, &im::KMeans1dResult::sizes, &im::KMeans1dResult::sse,
+                 &im::KMeans1dResult::iterations);
+  cls_kmeans1dresult
       .def_property_readonly(
           "status", [](const im::KMeans1dResult& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &im::KMeans1dResult::message)
@@ -182,7 +202,16 @@ counter-clockwise with y up.)doc");
       "k-means of the (flattened) values: 'exact' (globally optimal, dynamic programming) or "
       "'lloyd' (k-means++ start). Raises ValueError for empty or non-finite values.");
 
-  py::class_<im::Segmentation>(m, "Segmentation", "The segmentation of one image.")
+  py::class_<im::Segmentation> cls_segmentation(m, "Segmentation",
+                                                "The segmentation of one image.");
+  pickle_members(cls_segmentation, "Segmentation", &im::Segmentation::status,
+                 &im::Segmentation::message, &im::Segmentation::classes,
+                 &im::Segmentation::quantised, &im::Segmentation::high, &im::Segmentation::high_raw,
+                 &im::Segmentation::kmeans, &im::Segmentation::classes_count,
+                 &im::Segmentation::regions, &im::Segmentation::background_level,
+                 &im::Segmentation::high_level, &im::Segmentation::pixel_min,
+                 &im::Segmentation::pixel_max, &im::Segmentation::pixel_mean);
+  cls_segmentation
       .def_property_readonly(
           "classes", [](const im::Segmentation& s) { return s.classes; },
           "uint8 class per pixel: 0 background .. k-1 high pressure")
@@ -392,8 +421,13 @@ counter-clockwise with y up.)doc");
       "RecEdgeless: a height map from the image, gaps healed within rows and every column "
       "replaced by its least-squares polynomial of `degree`.");
 
-  py::class_<im::Recognition>(m, "Recognition", "The recogniser's result for one image.")
-      .def_readonly("edged", &im::Recognition::edged)
+  py::class_<im::Recognition> cls_recognition(m, "Recognition",
+                                              "The recogniser's result for one image.");
+  pickle_members(
+      cls_recognition, "Recognition", &im::Recognition::status, &im::Recognition::message,
+      &im::Recognition::edged, &im::Recognition::contour_gradient, &im::Recognition::regional,
+      &im::Recognition::edge_features, &im::Recognition::hybrid, &im::Recognition::label);
+  cls_recognition.def_readonly("edged", &im::Recognition::edged)
       .def_readonly("contour_gradient", &im::Recognition::contour_gradient,
                     "mean contour gradient magnitude of the largest HPR (feature 18)")
       .def_readonly("regional", &im::Recognition::regional, "the 11 regional features")
@@ -402,18 +436,24 @@ counter-clockwise with y up.)doc");
           "hybrid", &im::Recognition::hybrid,
           "rows*cols gradient magnitudes (row-major) followed by the 11 regional features");
 
-  py::class_<PyRecognizer>(m, "Recognizer", R"doc(
+  py::class_<PyRecognizer> cls_recognizer(m, "Recognizer", R"doc(
 The second paper's chain for images of rows x cols: segmentation, HPR descriptors, contour
 gradients, the edged/edgeless decision (mean contour gradient of the largest HPR above
-gradient_threshold) and the feature vectors.)doc")
+gradient_threshold) and the feature vectors.)doc");
+  pickle_with(
+      cls_recognizer, "Recognizer", [](const PyRecognizer& r) { return r.args; },
+      [](const py::tuple& a) {
+        if (a.size() != 8) throw py::value_error("Recognizer: damaged pickled state");
+        return make_recognizer(a[0].cast<py::ssize_t>(), a[1].cast<py::ssize_t>(),
+                               a[2].cast<double>(), a[3].cast<std::string>(), a[4].cast<int>(),
+                               a[5].cast<std::string>(), a[6].cast<int>(), a[7].cast<int>());
+      });
+  cls_recognizer
       .def(py::init([](py::ssize_t rows, py::ssize_t cols, double gradient_threshold,
                        const std::string& gradient_source, int k, const std::string& polarity,
                        int min_area, int connectivity) {
-             im::RecognizerConfig cfg;
-             cfg.segmentation = segmentation_config(k, polarity, min_area, connectivity, 65536);
-             cfg.gradient_source = enum_from(gradient_source, kGradientSources, "gradient_source");
-             return PyRecognizer{
-                 im::Recognizer<>(rows, cols, cfg, im::GradientThreshold{gradient_threshold})};
+             return make_recognizer(rows, cols, gradient_threshold, gradient_source, k, polarity,
+                                    min_area, connectivity);
            }),
            py::arg("rows") = 32, py::arg("cols") = 32, py::kw_only(),
            py::arg("gradient_threshold") = 25.0, py::arg("gradient_source") = "raw",

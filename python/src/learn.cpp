@@ -377,7 +377,12 @@ files.)doc");
            py::arg("batch_size") = 32, py::arg("tolerance") = 1e-5, py::arg("patience") = 10,
            py::arg("seed") = 1);
 
-  py::class_<ln::CvReport>(m, "CvReport", "Out-of-fold results of cross_validate.")
+  py::class_<ln::CvReport> cls_cvreport(m, "CvReport", "Out-of-fold results of cross_validate.");
+  pickle_members(cls_cvreport, "CvReport", &ln::CvReport::status, &ln::CvReport::message,
+                 &ln::CvReport::classes, &ln::CvReport::confusion,
+                 &ln::CvReport::per_class_accuracy, &ln::CvReport::accuracy,
+                 &ln::CvReport::predicted, &ln::CvReport::fold);
+  cls_cvreport
       .def_property_readonly("status",
                              [](const ln::CvReport& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &ln::CvReport::message)
@@ -416,7 +421,15 @@ files.)doc");
       "group in one fold; snr_db adds white noise to the test (or both) features. The folds "
       "train on `threads` threads (0: every core); the report does not depend on it.");
 
-  py::class_<ln::FiveByTwoResult>(m, "FiveByTwoResult", "Dietterich's 5x2cv paired t test.")
+  py::class_<ln::FiveByTwoResult> cls_fivebytworesult(m, "FiveByTwoResult",
+                                                      "Dietterich's 5x2cv paired t test.");
+  pickle_members(cls_fivebytworesult, "FiveByTwoResult", &ln::FiveByTwoResult::status,
+                 &ln::FiveByTwoResult::message, &ln::FiveByTwoResult::differences,
+                 &ln::FiveByTwoResult::t, &ln::FiveByTwoResult::p_value,
+                 &ln::FiveByTwoResult::alpha, &ln::FiveByTwoResult::critical,
+                 &ln::FiveByTwoResult::reject, &ln::FiveByTwoResult::mean_error_a,
+                 &ln::FiveByTwoResult::mean_error_b);
+  cls_fivebytworesult
       .def_property_readonly(
           "status", [](const ln::FiveByTwoResult& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &ln::FiveByTwoResult::message)

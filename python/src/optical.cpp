@@ -123,10 +123,27 @@ a frame into heights in metres, positive into the gel, and masks; ``find_dots`` 
 ``MarkerTracker`` follow the gel's marker dots as a displacement field in pixels.)doc");
 
   using CalPtr = std::shared_ptr<to::Calibration>;
-  py::class_<to::Calibration, CalPtr>(o, "Calibration", R"doc(
+  py::class_<to::Calibration, CalPtr> calibration_cls(o, "Calibration", R"doc(
 A map from colour change to surface slope, with the background frame it was made over, each
 press's contact circle and the held-out slope errors. Immutable; ``save`` and ``load`` keep it
-in a file (JSON when the name ends in .json, binary .txcal otherwise).)doc")
+in a file (JSON when the name ends in .json, binary .txcal otherwise).)doc");
+  calibration_cls.def(py::pickle(
+      [](const to::Calibration& c) {
+        return py::make_tuple(1, py::bytes(to::encode_calibration(c)));
+      },
+      [](const py::tuple& t) {
+        if (t.size() != 2 || t[0].cast<int>() != 1) {
+          throw py::value_error("Calibration: not a pickled state of version 1");
+        }
+        return std::make_shared<to::Calibration>(to::decode_calibration(
+            std::string_view(t[1].cast<py::bytes>()), "pickled Calibration"));
+      }));
+  // Immutable: a copy may share it.
+  calibration_cls.def("__copy__", [](const py::object& self) { return self; });
+  calibration_cls.def(
+      "__deepcopy__", [](const py::object& self, const py::dict&) { return self; },
+      py::arg("memo"));
+  calibration_cls
       .def_property_readonly(
           "rows", [](const to::Calibration& c) { return c.rows; },
           "Frame rows the calibration is for.")

@@ -128,7 +128,13 @@ with field_cell > 0 [m], a closest-point field for approximate correspondences.)
           "(ids, distances [m]) of the closest target point to each (N, 3) query; -1 and NaN "
           "for a non-finite query");
 
-  py::class_<reg::IcpResult>(m, "IcpResult", "The outcome of one alignment.")
+  py::class_<reg::IcpResult> cls_icpresult(m, "IcpResult", "The outcome of one alignment.");
+  pickle_members(cls_icpresult, "IcpResult", &reg::IcpResult::status, &reg::IcpResult::message,
+                 &reg::IcpResult::transform, &reg::IcpResult::rmse,
+                 &reg::IcpResult::inlier_fraction, &reg::IcpResult::inliers,
+                 &reg::IcpResult::skipped, &reg::IcpResult::iterations,
+                 &reg::IcpResult::information);
+  cls_icpresult
       .def_property_readonly(
           "status", [](const reg::IcpResult& r) { return std::string(to_string(r.status)); },
           "'ok', 'not_converged', 'degenerate' or 'invalid_input'")
@@ -148,10 +154,28 @@ with field_cell > 0 [m], a closest-point field for approximate correspondences.)
                ", iterations=" + std::to_string(r.iterations) + ")";
       });
 
-  py::class_<PyIcp>(m, "Icp", R"doc(
+  py::class_<PyIcp> cls_icp(m, "Icp", R"doc(
 Iterative closest point. error: 'point_to_plane' (default) or 'point_to_point'; kernel:
 'none', 'huber', 'cauchy', 'geman_mcclure' or 'tukey', with `kernel_scale` [m] (None: the
-kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.)doc")
+kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.)doc");
+  pickle_with(
+      cls_icp, "Icp",
+      [](const PyIcp& i) {
+        const reg::IcpConfig& c = i.config;
+        return py::make_tuple(i.error, i.kernel, i.kernel_scale, c.max_iterations, c.max_distance,
+                              c.trim_fraction, c.translation_tolerance, c.rotation_tolerance,
+                              c.relative_error_tolerance, c.min_correspondences, c.approximate,
+                              c.coarse_points);
+      },
+      [](const py::tuple& t) {
+        if (t.size() != 12) throw py::value_error("Icp: damaged pickled state");
+        reg::IcpConfig c{t[3].cast<int>(),         t[4].cast<double>(), t[5].cast<double>(),
+                         t[6].cast<double>(),      t[7].cast<double>(), t[8].cast<double>(),
+                         t[9].cast<std::size_t>(), t[10].cast<bool>(),  t[11].cast<std::size_t>()};
+        (void)reg::Icp<>(c);
+        return PyIcp{t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].cast<double>(), c};
+      });
+  cls_icp
       .def(
           py::init([](const std::string& error, const std::string& kernel,
                       std::optional<double> kernel_scale, int max_iterations, double max_distance,
@@ -194,8 +218,13 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
           "Aligns source (N, 3) [m] to target from `initial` (4x4, default identity). Returns an "
           "IcpResult; its transform maps source points into the target frame.");
 
-  py::class_<reg::ModelMatch>(m, "ModelMatch", "How well one model explains the cloud.")
-      .def_readonly("name", &reg::ModelMatch::name)
+  py::class_<reg::ModelMatch> cls_modelmatch(m, "ModelMatch",
+                                             "How well one model explains the cloud.");
+  pickle_members(cls_modelmatch, "ModelMatch", &reg::ModelMatch::name, &reg::ModelMatch::model,
+                 &reg::ModelMatch::score, &reg::ModelMatch::rmse, &reg::ModelMatch::inlier_fraction,
+                 &reg::ModelMatch::transform, &reg::ModelMatch::icp_status, &reg::ModelMatch::exact,
+                 &reg::ModelMatch::starts, &reg::ModelMatch::starts_stopped_early);
+  cls_modelmatch.def_readonly("name", &reg::ModelMatch::name)
       .def_readonly("model", &reg::ModelMatch::model, "index in the library")
       .def_readonly("score", &reg::ModelMatch::score, "truncated RMS distance [m], lower is better")
       .def_readonly("rmse", &reg::ModelMatch::rmse)
@@ -212,7 +241,13 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
         return "ModelMatch(name='" + r.name + "', score=" + std::to_string(r.score) + ")";
       });
 
-  py::class_<reg::ObjectRecognition>(m, "ObjectRecognition", "The answer of recognize().")
+  py::class_<reg::ObjectRecognition> cls_objectrecognition(m, "ObjectRecognition",
+                                                           "The answer of recognize().");
+  pickle_members(cls_objectrecognition, "ObjectRecognition", &reg::ObjectRecognition::status,
+                 &reg::ObjectRecognition::message, &reg::ObjectRecognition::ranking,
+                 &reg::ObjectRecognition::best, &reg::ObjectRecognition::unknown,
+                 &reg::ObjectRecognition::margin);
+  cls_objectrecognition
       .def_property_readonly(
           "status",
           [](const reg::ObjectRecognition& r) { return std::string(to_string(r.status)); })

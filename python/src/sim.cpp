@@ -199,6 +199,29 @@ palm-grasp pressure-image synthesiser.)doc");
         return sm::TriangleMesh(std::move(v), std::move(t));
       }),
       py::arg("vertices"), py::arg("triangles"));
+  pickle_with(
+      mesh, "TriangleMesh",
+      [](const sm::TriangleMesh& t) {
+        py::array_t<std::int64_t> tri(
+            {static_cast<py::ssize_t>(t.triangles().size()), py::ssize_t{3}});
+        for (std::size_t i = 0; i < t.triangles().size(); ++i) {
+          for (std::size_t j = 0; j < 3; ++j) tri.mutable_data()[3 * i + j] = t.triangles()[i][j];
+        }
+        return py::make_tuple(points_array(t.vertices()), tri);
+      },
+      [](const py::tuple& a) {
+        const auto v = a[0].cast<ArrayD>();
+        const auto t = a[1].cast<ArrayI64>();
+        require_shape(t, {-1, 3}, "pickled triangles", "(T, 3)");
+        std::vector<sm::TriangleMesh::Triangle> tri(static_cast<std::size_t>(t.shape(0)));
+        for (py::ssize_t i = 0; i < t.size(); ++i) {
+          const std::int64_t k = t.data()[i];
+          if (k < 0 || k >= v.shape(0)) throw py::value_error("pickled triangles: bad index");
+          tri[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] =
+              static_cast<std::uint32_t>(k);
+        }
+        return sm::TriangleMesh(points_from(v, "pickled vertices"), std::move(tri));
+      });
   shape_methods(mesh);
   m.def("icosphere", &sm::icosphere<>, py::arg("radius"), py::arg("subdivisions"),
         "A sphere mesh: an icosahedron subdivided `subdivisions` times, vertices on the sphere.");
@@ -340,9 +363,22 @@ palm-grasp pressure-image synthesiser.)doc");
       py::arg("hold_frames") = 10, TAXEL_EXPLORATION_ARGS,
       "Presses one pad onto the shape `touches` times.");
 
-  py::class_<sm::PalmGraspSynth>(m, "PalmGraspSynth", R"doc(
+  py::class_<sm::PalmGraspSynth> cls_palmgraspsynth(m, "PalmGraspSynth", R"doc(
 Synthetic palm pressure images (rows x cols, 0..255) of four grasp classes: 1 planar,
-2 one-edged, 3 two-edged, 4 cylindrical; subjects differ in hand size, finger width and force.)doc")
+2 one-edged, 3 two-edged, 4 cylindrical; subjects differ in hand size, finger width and force.)doc");
+  pickle_with(
+      cls_palmgraspsynth, "PalmGraspSynth",
+      [](const sm::PalmGraspSynth& g) {
+        return py::make_tuple(g.config().rows, g.config().cols, g.config().fingers, g.seed());
+      },
+      [](const py::tuple& a) {
+        sm::PalmGraspConfig c;
+        c.rows = a[0].cast<int>();
+        c.cols = a[1].cast<int>();
+        c.fingers = a[2].cast<int>();
+        return sm::PalmGraspSynth(c, a[3].cast<std::uint64_t>());
+      });
+  cls_palmgraspsynth
       .def(py::init([](int rows, int cols, int fingers, std::uint64_t seed) {
              sm::PalmGraspConfig c;
              c.rows = rows;

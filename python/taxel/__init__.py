@@ -17,6 +17,33 @@ for _name in ("fusion", "image", "io", "optical", "registration", "sensor", "sim
 
 from . import learn  # noqa: E402 - the estimators over the compiled taxel._taxel.learn
 
+
+def _pickle_by_arguments(cls, names):
+    """Pickling and copies of a class that its constructor's keyword arguments, each readable
+    as an attribute of the same name, fully describe (shapes, sensor models, options)."""
+    import copyreg
+    import functools
+
+    def reduce(obj):
+        return functools.partial(cls, **{n: getattr(obj, n) for n in names}), ()
+
+    copyreg.pickle(cls, reduce)
+
+
+for _cls, _names in (
+    (sim.Sphere, ("radius",)),
+    (sim.Cylinder, ("radius", "half_height")),
+    (sim.Box, ("half_extents",)),
+    (sim.Cone, ("radius", "height")),
+    (sim.Ellipsoid, ("semi_axes",)),
+    (sim.Torus, ("major_radius", "minor_radius")),
+    (sensor.SensorModel, ("rows", "cols", "pitch", "full_scale_depth", "levels", "threshold",
+                          "sigma_normal", "sigma_position", "sigma_tilt")),
+    (sensor.ContactOptions, ("mode", "local_normals", "correct_censoring", "fallback_normal_sigma",
+                             "refine_censoring", "tactel_area")),
+):
+    _pickle_by_arguments(_cls, _names)
+
 __all__ = [
     "Contacts",
     "IoError",

@@ -46,8 +46,10 @@ the C++ loop with no conversion."""
 class PointCloud:
     """Points [m] with optional unit normals and named per-point scalar fields.
 
-Arrays are copied in and out: ``cloud.points`` is an (N, 3) float64 array, ``cloud.normals``
-an (N, 3) array or None, ``cloud.fields`` a dict of (N,) arrays."""
+Arrays are copied in. Out, ``cloud.points`` (N, 3), ``cloud.normals`` (N, 3) or None and the
+(N,) arrays of ``cloud.fields`` are read-only views of the cloud's memory (no copy; each keeps
+the cloud alive). A PointCloud never changes once made, so the views stay valid; copy one
+(``np.array(cloud.points)``) to change it. Clouds pickle and deep-copy."""
     def __init__(self, points: numpy.typing.NDArray[numpy.float64], normals: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, fields: typing.Optional[typing.Dict[str, numpy.typing.NDArray[numpy.float64]]] = None) -> None: ...
     def __len__(self) -> int: ...
     def __repr__(self) -> str: ...

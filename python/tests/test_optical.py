@@ -165,3 +165,18 @@ def test_a_reconstructor_follows_a_drift_of_the_lighting(rig):
     assert optical.Reconstructor(cal)(frame)["mask"].mean() > 0.5  # without it, all deformed
     with pytest.raises(ValueError, match="drift_rate"):
         optical.Reconstructor(cal, drift_rate=2.0)
+
+
+def test_calibrations_pickle_and_copy(rig):
+    import copy
+    import pickle
+
+    _, background, presses, _, cal = rig
+    again = pickle.loads(pickle.dumps(cal))
+    for name in ("rows", "cols", "pixel", "method", "heldout", "heldout_polynomial", "heldout_table"):
+        assert getattr(again, name) == getattr(cal, name)
+    np.testing.assert_array_equal(again.circles, cal.circles)
+    a = optical.reconstruct(presses[0], cal)
+    b = optical.reconstruct(presses[0], again)
+    np.testing.assert_array_equal(a["height"], b["height"])
+    assert copy.deepcopy(cal) is cal  # immutable

@@ -282,6 +282,8 @@ class PalmGraspSynth {
 
   /// The configuration.
   [[nodiscard]] const PalmGraspConfig& config() const noexcept { return cfg_; }
+  /// The seed the images are drawn with.
+  [[nodiscard]] std::uint64_t seed() const noexcept { return seed_; }
 
  private:
   // Pressure pattern of the hand at (a across, b along); 0 off the hand.
