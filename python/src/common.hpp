@@ -263,8 +263,10 @@ void pickle_with(py::class_<T>& cls, const char* name, Args args, Make make) {
                        }
                        return make(s[1].cast<py::tuple>());
                      }));
-  cls.def(
-      "__deepcopy__", [](const T& t, const py::dict&) { return T(t); }, py::arg("memo"));
+  if constexpr (std::is_copy_constructible_v<T>) {
+    cls.def(
+        "__deepcopy__", [](const T& t, const py::dict&) { return T(t); }, py::arg("memo"));
+  }  // else copy.deepcopy goes through the pickled state
 }
 
 /// 3-vectors from an (N, 3) array.
@@ -352,6 +354,7 @@ using ContactList = std::vector<Contact<double>>;
 
 void bind_core(py::module_& m);
 void bind_fusion(py::module_& m);
+void bind_index(py::module_& m);
 void bind_registration(py::module_& m);
 void bind_image(py::module_& m);
 void bind_learn(py::module_& m);

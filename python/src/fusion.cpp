@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "index_queries.hpp"
 #include "taxel/fusion.hpp"
 #include "taxel/index/brute_force.hpp"
 #include "taxel/index/dynamic_kdtree.hpp"
@@ -51,6 +52,9 @@ class CloudBase {
   virtual void covariances(double* out) const = 0;
   virtual void observations(std::uint32_t* out) const = 0;
   virtual void last_times(double* out) const = 0;
+  /// The k points nearest to q and every point within r of q (the index's answers).
+  virtual std::vector<index::Neighbor<double>> knn(const Vec3d& q, std::size_t k) const = 0;
+  virtual std::vector<index::Neighbor<double>> within(const Vec3d& q, double r) const = 0;
   /// Doubles per point state (the policy's for_each_field).
   virtual std::size_t state_size() const = 0;
   /// Every point's state into out[size() * state_size()].
@@ -100,6 +104,12 @@ class CloudImpl final : public CloudBase {
     for (std::size_t i = 0; i < cloud_.size(); ++i) {
       out[i] = cloud_.last_time(static_cast<index::PointId>(i));
     }
+  }
+  std::vector<index::Neighbor<double>> knn(const Vec3d& q, std::size_t k) const override {
+    return cloud_.index().knn(q, k);
+  }
+  std::vector<index::Neighbor<double>> within(const Vec3d& q, double r) const override {
+    return cloud_.index().within(q, r);
   }
   std::size_t state_size() const override {
     std::size_t n = 0;
@@ -511,6 +521,33 @@ Options that the chosen policy or index does not use must stay at their defaults
             }
             return c;
           }))
+      .def(
+          "query",
+          [](const PyContactCloud& c, const ArrayD& x, std::size_t k) {
+            std::size_t n = 0;
+            {
+              py::gil_scoped_release release;
+              const auto lock = read_lock(&c);
+              n = c.impl->size();
+            }
+            return knn_query(x, k, n, [&](const Vec3d& q, std::size_t kk) {
+              const auto lock = read_lock(&c);
+              return c.impl->knn(q, kk);
+            });
+          },
+          py::arg("x"), py::arg("k") = 1,
+          (std::string("Nearest fused points (their means; ids are rows of `means`). ") + kQueryDoc)
+              .c_str())
+      .def(
+          "query_ball_point",
+          [](const PyContactCloud& c, const ArrayD& x, double r) {
+            return radius_query(x, r, [&](const Vec3d& q, double rr) {
+              const auto lock = read_lock(&c);
+              return c.impl->within(q, rr);
+            });
+          },
+          py::arg("x"), py::arg("r"),
+          (std::string("Fused points within r (ids are rows of `means`). ") + kBallDoc).c_str())
       .def_readonly("policy", &PyContactCloud::policy)
       .def_readonly("index", &PyContactCloud::index)
       .def_readonly("association_radius", &PyContactCloud::association_radius)

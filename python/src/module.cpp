@@ -13,6 +13,7 @@ PYBIND11_MODULE(_taxel, m) {
   pybind11::register_exception<taxel::ProtocolError>(m, "ProtocolError", PyExc_OSError);
   tp::bind_core(m);
   tp::bind_fusion(m);
+  tp::bind_index(m);
   tp::bind_registration(m);
   tp::bind_image(m);
   tp::bind_learn(m);

@@ -9,10 +9,10 @@ import sys as _sys
 
 from . import _taxel
 from ._taxel import Contacts, IoError, PointCloud, ProtocolError, __version__
-from ._taxel import fusion, image, io, optical, registration, sensor, sim
+from ._taxel import fusion, image, index, io, optical, registration, sensor, sim
 
 # `import taxel.fusion` and `from taxel.image import segment` work like for any package.
-for _name in ("fusion", "image", "io", "optical", "registration", "sensor", "sim"):
+for _name in ("fusion", "image", "index", "io", "optical", "registration", "sensor", "sim"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_taxel, _name)
 
 from . import learn  # noqa: E402 - the estimators over the compiled taxel._taxel.learn
@@ -52,6 +52,7 @@ __all__ = [
     "__version__",
     "fusion",
     "image",
+    "index",
     "io",
     "learn",
     "optical",

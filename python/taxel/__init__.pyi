@@ -9,6 +9,7 @@ import numpy.typing
 import taxel
 import taxel.fusion
 import taxel.image
+import taxel.index
 import taxel.io
 import taxel.learn
 import taxel.optical
@@ -66,6 +67,7 @@ class ProtocolError(OSError): ...
 __version__: str
 from taxel import fusion as fusion
 from taxel import image as image
+from taxel import index as index
 from taxel import io as io
 from taxel import learn as learn
 from taxel import optical as optical

@@ -9,6 +9,7 @@ import numpy.typing
 import taxel
 import taxel.fusion
 import taxel.image
+import taxel.index
 import taxel.io
 import taxel.learn
 import taxel.optical
@@ -60,6 +61,8 @@ Options that the chosen policy or index does not use must stay at their defaults
     def observations(self) -> numpy.typing.NDArray[numpy.uint32]: ...
     @property
     def policy(self) -> str: ...
+    def query(self, x: numpy.typing.NDArray[numpy.float64], k: int = 1) -> typing.Tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.int64]]: """Nearest fused points (their means; ids are rows of `means`). The k nearest points to each row of x (M, 3) [m]: (distances, ids), each (M,) for k = 1 and (M, k) otherwise, nearest first, ties by id. Where fewer than k points exist the distance is inf and the id is len(self), as scipy's cKDTree gives them. A query row that is not finite finds nothing. Releases the GIL."""
+    def query_ball_point(self, x: numpy.typing.NDArray[numpy.float64], r: float) -> typing.List[numpy.typing.NDArray[numpy.int64]]: """Fused points within r (ids are rows of `means`). The points within distance r [m] of each row of x (M, 3): a list of M int64 arrays of ids, nearest first, ties by id (cKDTree's query_ball_point, whose lists are unordered). Releases the GIL."""
     def reserve(self, n: int) -> None: """Makes room for n points (MemoryError when memory runs out)."""
     def to_point_cloud(self, *, min_observations: int = 1, max_sigma: float = ..., max_normal_sigma: float = ...) -> taxel.PointCloud: """The confident points as a PointCloud with fields 'observations', 'cov_xx' .. 'cov_zz', 'last_time' (and normals with the surfel policy)."""
 

@@ -9,6 +9,7 @@ import numpy.typing
 import taxel
 import taxel.fusion
 import taxel.image
+import taxel.index
 import taxel.io
 import taxel.learn
 import taxel.optical

@@ -17,7 +17,7 @@ import sys
 import taxel
 from taxel import _taxel
 
-SUBMODULES = ("fusion", "image", "io", "optical", "registration", "sensor", "sim")
+SUBMODULES = ("fusion", "image", "index", "io", "optical", "registration", "sensor", "sim")
 # Pure-Python submodules: typed inline (py.typed), so they get no stub of their own.
 PYTHON_MODULES = ("learn",)
 F64 = "numpy.typing.NDArray[numpy.float64]"
@@ -25,6 +25,10 @@ F64 = "numpy.typing.NDArray[numpy.float64]"
 RETURNS = {
     "fusion.ContactCloud.insert": "taxel.fusion.InsertResult",
     "fusion.ContactCloud.insert_readings": "taxel.fusion.InsertResult",
+    "fusion.ContactCloud.query": f"typing.Tuple[{F64}, numpy.typing.NDArray[numpy.int64]]",
+    "fusion.ContactCloud.query_ball_point": "typing.List[numpy.typing.NDArray[numpy.int64]]",
+    "index.KdTree.query": f"typing.Tuple[{F64}, numpy.typing.NDArray[numpy.int64]]",
+    "index.KdTree.query_ball_point": "typing.List[numpy.typing.NDArray[numpy.int64]]",
     "image.Recognizer.features": "taxel.image.ImageFeatures",
     "image.gradient": f"typing.Tuple[{F64}, {F64}]",
     "image.sobel": f"typing.Tuple[{F64}, {F64}]",
