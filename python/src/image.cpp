@@ -157,16 +157,16 @@ counter-clockwise with y up.)doc");
   cls_kmeans1dresult
       .def_property_readonly(
           "status", [](const im::KMeans1dResult& r) { return std::string(to_string(r.status)); })
-      .def_readonly("message", &im::KMeans1dResult::message)
+      .def_readonly("message", &im::KMeans1dResult::message, "why, when status is not 'ok'")
       .def_readonly("k", &im::KMeans1dResult::k,
                     "clusters found: min(k_requested, distinct values)")
-      .def_readonly("k_requested", &im::KMeans1dResult::k_requested)
-      .def_readonly("centroids", &im::KMeans1dResult::centroids)
+      .def_readonly("k_requested", &im::KMeans1dResult::k_requested, "the number of clusters asked for")
+      .def_readonly("centroids", &im::KMeans1dResult::centroids, "cluster centres, ascending")
       .def_readonly("lower", &im::KMeans1dResult::lower, "smallest value of each cluster")
       .def_readonly("upper", &im::KMeans1dResult::upper, "largest value of each cluster")
-      .def_readonly("sizes", &im::KMeans1dResult::sizes)
+      .def_readonly("sizes", &im::KMeans1dResult::sizes, "values in each cluster")
       .def_readonly("sse", &im::KMeans1dResult::sse, "within-cluster sum of squared deviations")
-      .def_readonly("iterations", &im::KMeans1dResult::iterations)
+      .def_readonly("iterations", &im::KMeans1dResult::iterations, "Lloyd iterations (0 for the exact solver)")
       .def(
           "labels",
           [](const im::KMeans1dResult& r, const ArrayD& values) {
@@ -222,13 +222,13 @@ counter-clockwise with y up.)doc");
           "high", [](const im::Segmentation& s) { return s.high; },
           "uint8 mask of the HPR pixels after removal of small regions")
       .def_property_readonly("high_raw", [](const im::Segmentation& s) { return s.high_raw; })
-      .def_readonly("kmeans", &im::Segmentation::kmeans)
+      .def_readonly("kmeans", &im::Segmentation::kmeans, "the clustering of the pixel values (KMeans1dResult)")
       .def_readonly("regions", &im::Segmentation::regions, "HPR components kept")
-      .def_readonly("background_level", &im::Segmentation::background_level)
-      .def_readonly("high_level", &im::Segmentation::high_level)
-      .def_readonly("pixel_min", &im::Segmentation::pixel_min)
-      .def_readonly("pixel_max", &im::Segmentation::pixel_max)
-      .def_readonly("pixel_mean", &im::Segmentation::pixel_mean);
+      .def_readonly("background_level", &im::Segmentation::background_level, "centroid of the background cluster")
+      .def_readonly("high_level", &im::Segmentation::high_level, "centroid of the high-pressure cluster")
+      .def_readonly("pixel_min", &im::Segmentation::pixel_min, "smallest pixel value")
+      .def_readonly("pixel_max", &im::Segmentation::pixel_max, "largest pixel value")
+      .def_readonly("pixel_mean", &im::Segmentation::pixel_mean, "mean pixel value");
 
   // One body for segment (an image) and segment_stack (frames): every frame segmented by one
   // Segmenter, the GIL released per frame.
@@ -427,7 +427,7 @@ counter-clockwise with y up.)doc");
       cls_recognition, "Recognition", &im::Recognition::status, &im::Recognition::message,
       &im::Recognition::edged, &im::Recognition::contour_gradient, &im::Recognition::regional,
       &im::Recognition::edge_features, &im::Recognition::hybrid, &im::Recognition::label);
-  cls_recognition.def_readonly("edged", &im::Recognition::edged)
+  cls_recognition.def_readonly("edged", &im::Recognition::edged, "the edged/edgeless decision")
       .def_readonly("contour_gradient", &im::Recognition::contour_gradient,
                     "mean contour gradient magnitude of the largest HPR (feature 18)")
       .def_readonly("regional", &im::Recognition::regional, "the 11 regional features")

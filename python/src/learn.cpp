@@ -385,13 +385,13 @@ files.)doc");
   cls_cvreport
       .def_property_readonly("status",
                              [](const ln::CvReport& r) { return std::string(to_string(r.status)); })
-      .def_readonly("message", &ln::CvReport::message)
-      .def_readonly("accuracy", &ln::CvReport::accuracy)
+      .def_readonly("message", &ln::CvReport::message, "why, when status is not 'ok'")
+      .def_readonly("accuracy", &ln::CvReport::accuracy, "fraction of samples predicted right")
       .def_property_readonly("classes",
                              [](const ln::CvReport& r) { return vector_array(r.classes); })
       .def_readonly("confusion", &ln::CvReport::confusion,
                     "[true class][predicted class], in `classes` order")
-      .def_readonly("per_class_accuracy", &ln::CvReport::per_class_accuracy)
+      .def_readonly("per_class_accuracy", &ln::CvReport::per_class_accuracy, "recall of each class, in `classes` order")
       .def_property_readonly("predicted",
                              [](const ln::CvReport& r) { return vector_array(r.predicted); })
       .def_property_readonly("fold", [](const ln::CvReport& r) { return vector_array(r.fold); });
@@ -432,7 +432,7 @@ files.)doc");
   cls_fivebytworesult
       .def_property_readonly(
           "status", [](const ln::FiveByTwoResult& r) { return std::string(to_string(r.status)); })
-      .def_readonly("message", &ln::FiveByTwoResult::message)
+      .def_readonly("message", &ln::FiveByTwoResult::message, "why, when status is not 'ok'")
       .def_property_readonly(
           "differences",
           [](const ln::FiveByTwoResult& r) {
@@ -443,13 +443,13 @@ files.)doc");
             return out;
           },
           "(5, 2) error of A minus error of B per replication and fold")
-      .def_readonly("t", &ln::FiveByTwoResult::t)
-      .def_readonly("p_value", &ln::FiveByTwoResult::p_value)
-      .def_readonly("alpha", &ln::FiveByTwoResult::alpha)
-      .def_readonly("critical", &ln::FiveByTwoResult::critical)
-      .def_readonly("reject", &ln::FiveByTwoResult::reject)
-      .def_readonly("mean_error_a", &ln::FiveByTwoResult::mean_error_a)
-      .def_readonly("mean_error_b", &ln::FiveByTwoResult::mean_error_b);
+      .def_readonly("t", &ln::FiveByTwoResult::t, "the 5x2cv t statistic")
+      .def_readonly("p_value", &ln::FiveByTwoResult::p_value, "two-sided p-value, Student t with 5 degrees of freedom")
+      .def_readonly("alpha", &ln::FiveByTwoResult::alpha, "significance level")
+      .def_readonly("critical", &ln::FiveByTwoResult::critical, "|t| above this rejects")
+      .def_readonly("reject", &ln::FiveByTwoResult::reject, "whether equal error rates are rejected")
+      .def_readonly("mean_error_a", &ln::FiveByTwoResult::mean_error_a, "mean error rate of A over the ten folds")
+      .def_readonly("mean_error_b", &ln::FiveByTwoResult::mean_error_b, "mean error rate of B over the ten folds");
 
   m.def(
       "five_by_two_t_test",

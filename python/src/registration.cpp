@@ -138,16 +138,16 @@ with field_cell > 0 [m], a closest-point field for approximate correspondences.)
       .def_property_readonly(
           "status", [](const reg::IcpResult& r) { return std::string(to_string(r.status)); },
           "'ok', 'not_converged', 'degenerate' or 'invalid_input'")
-      .def_readonly("message", &reg::IcpResult::message)
+      .def_readonly("message", &reg::IcpResult::message, "why, when status is not 'ok'")
       .def_property_readonly("ok", [](const reg::IcpResult& r) { return r.ok(); })
       .def_property_readonly(
           "transform", [](const reg::IcpResult& r) { return pose_array(r.transform); },
           "T_target_source, a 4x4 matrix")
       .def_readonly("rmse", &reg::IcpResult::rmse, "RMS distance of the inlier pairs [m]")
-      .def_readonly("inlier_fraction", &reg::IcpResult::inlier_fraction)
-      .def_readonly("inliers", &reg::IcpResult::inliers)
+      .def_readonly("inlier_fraction", &reg::IcpResult::inlier_fraction, "inliers / finite source points")
+      .def_readonly("inliers", &reg::IcpResult::inliers, "pairs kept by the distance gate and trimming")
       .def_readonly("skipped", &reg::IcpResult::skipped, "non-finite source points ignored")
-      .def_readonly("iterations", &reg::IcpResult::iterations)
+      .def_readonly("iterations", &reg::IcpResult::iterations, "updates applied")
       .def("__repr__", [](const reg::IcpResult& r) {
         return "IcpResult(status='" + std::string(to_string(r.status)) +
                "', rmse=" + std::to_string(r.rmse) +
@@ -200,9 +200,9 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
           py::arg("rotation_tolerance") = 1e-6, py::arg("relative_error_tolerance") = 0.0,
           py::arg("min_correspondences") = 0, py::arg("approximate") = false,
           py::arg("coarse_points") = 0)
-      .def_readonly("error", &PyIcp::error)
-      .def_readonly("kernel", &PyIcp::kernel)
-      .def_readonly("kernel_scale", &PyIcp::kernel_scale)
+      .def_readonly("error", &PyIcp::error, "'point_to_plane' or 'point_to_point'")
+      .def_readonly("kernel", &PyIcp::kernel, "the robust kernel's name")
+      .def_readonly("kernel_scale", &PyIcp::kernel_scale, "the kernel's scale [m]")
       .def(
           "align",
           [](const PyIcp& icp, const reg::Target<double>& target, const ArrayD& source,
@@ -224,19 +224,19 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
                  &reg::ModelMatch::score, &reg::ModelMatch::rmse, &reg::ModelMatch::inlier_fraction,
                  &reg::ModelMatch::transform, &reg::ModelMatch::icp_status, &reg::ModelMatch::exact,
                  &reg::ModelMatch::starts, &reg::ModelMatch::starts_stopped_early);
-  cls_modelmatch.def_readonly("name", &reg::ModelMatch::name)
+  cls_modelmatch.def_readonly("name", &reg::ModelMatch::name, "the model's name")
       .def_readonly("model", &reg::ModelMatch::model, "index in the library")
       .def_readonly("score", &reg::ModelMatch::score, "truncated RMS distance [m], lower is better")
-      .def_readonly("rmse", &reg::ModelMatch::rmse)
-      .def_readonly("inlier_fraction", &reg::ModelMatch::inlier_fraction)
+      .def_readonly("rmse", &reg::ModelMatch::rmse, "ICP inlier RMS distance [m]")
+      .def_readonly("inlier_fraction", &reg::ModelMatch::inlier_fraction, "ICP inliers / cloud points")
       .def_property_readonly(
           "transform", [](const reg::ModelMatch& r) { return pose_array(r.transform); },
           "T_model_cloud, a 4x4 matrix")
       .def_property_readonly(
           "icp_status",
           [](const reg::ModelMatch& r) { return std::string(to_string(r.icp_status)); })
-      .def_readonly("exact", &reg::ModelMatch::exact)
-      .def_readonly("starts", &reg::ModelMatch::starts)
+      .def_readonly("exact", &reg::ModelMatch::exact, "refined with exact correspondences")
+      .def_readonly("starts", &reg::ModelMatch::starts, "starts tried")
       .def("__repr__", [](const reg::ModelMatch& r) {
         return "ModelMatch(name='" + r.name + "', score=" + std::to_string(r.score) + ")";
       });
@@ -251,10 +251,10 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
       .def_property_readonly(
           "status",
           [](const reg::ObjectRecognition& r) { return std::string(to_string(r.status)); })
-      .def_readonly("message", &reg::ObjectRecognition::message)
+      .def_readonly("message", &reg::ObjectRecognition::message, "why, when status is not 'ok'")
       .def_readonly("ranking", &reg::ObjectRecognition::ranking, "ModelMatch list, best first")
       .def_readonly("best", &reg::ObjectRecognition::best, "the best model's name, or 'unknown'")
-      .def_readonly("unknown", &reg::ObjectRecognition::unknown)
+      .def_readonly("unknown", &reg::ObjectRecognition::unknown, "no model fits within the threshold")
       .def_readonly("margin", &reg::ObjectRecognition::margin,
                     "second score - best score [m] (0 with one model)")
       .def("__repr__", [](const reg::ObjectRecognition& r) {

@@ -147,37 +147,37 @@ palm-grasp pressure-image synthesiser.)doc");
 
   py::class_<sm::Sphere> sphere(m, "Sphere", "Sphere of `radius` [m] centred at the origin.");
   sphere.def(py::init<double>(), py::arg("radius") = 0.04)
-      .def_readonly("radius", &sm::Sphere::radius);
+      .def_readonly("radius", &sm::Sphere::radius, "radius [m]");
   shape_methods(sphere);
   py::class_<sm::Cylinder> cylinder(m, "Cylinder", "Capped cylinder along z.");
   cylinder.def(py::init<double, double>(), py::arg("radius") = 0.03, py::arg("half_height") = 0.05)
-      .def_readonly("radius", &sm::Cylinder::radius)
-      .def_readonly("half_height", &sm::Cylinder::half_height);
+      .def_readonly("radius", &sm::Cylinder::radius, "radius [m]")
+      .def_readonly("half_height", &sm::Cylinder::half_height, "half of the height [m]");
   shape_methods(cylinder);
   py::class_<sm::Box> box(m, "Box",
                           "Box of `half_extents` [m] centred at the origin, axis-aligned.");
   box.def(py::init([](const Eigen::Vector3d& h) { return sm::Box(h); }),
           py::arg("half_extents") = Eigen::Vector3d(0.04, 0.03, 0.02))
-      .def_readonly("half_extents", &sm::Box::half_extents);
+      .def_readonly("half_extents", &sm::Box::half_extents, "half side lengths along x, y, z [m]");
   shape_methods(box);
   py::class_<sm::Cone> cone(m, "Cone", "Cone along z, base radius and height.");
   cone.def(py::init<double, double>(), py::arg("radius") = 0.03, py::arg("height") = 0.06)
-      .def_readonly("radius", &sm::Cone::radius)
-      .def_readonly("height", &sm::Cone::height);
+      .def_readonly("radius", &sm::Cone::radius, "base radius [m]")
+      .def_readonly("height", &sm::Cone::height, "height [m]");
   shape_methods(cone);
   py::class_<sm::Ellipsoid> ellipsoid(m, "Ellipsoid",
                                       "Ellipsoid of `semi_axes` [m] along x, y, z.");
   ellipsoid
       .def(py::init([](const Eigen::Vector3d& e) { return sm::Ellipsoid(e); }),
            py::arg("semi_axes") = Eigen::Vector3d(0.05, 0.035, 0.025))
-      .def_readonly("semi_axes", &sm::Ellipsoid::semi_axes);
+      .def_readonly("semi_axes", &sm::Ellipsoid::semi_axes, "semi-axes along x, y, z [m]");
   shape_methods(ellipsoid);
   py::class_<sm::Torus> torus(m, "Torus", "Torus around z.");
   torus
       .def(py::init<double, double>(), py::arg("major_radius") = 0.04,
            py::arg("minor_radius") = 0.015)
-      .def_readonly("major_radius", &sm::Torus::major_radius)
-      .def_readonly("minor_radius", &sm::Torus::minor_radius);
+      .def_readonly("major_radius", &sm::Torus::major_radius, "distance from the axis to the tube's centre [m]")
+      .def_readonly("minor_radius", &sm::Torus::minor_radius, "the tube's radius [m]");
   shape_methods(torus);
   py::class_<sm::TriangleMesh> mesh(m, "TriangleMesh",
                                     "A closed triangle mesh; closest points through a bounding-"

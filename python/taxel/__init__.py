@@ -60,3 +60,11 @@ __all__ = [
     "sensor",
     "sim",
 ]
+
+from . import _reprs  # noqa: E402
+
+_reprs.install(_sys.modules[__name__])
+
+from . import _errors  # noqa: E402
+
+_errors.install(_taxel, fusion, image, index, io, optical, registration, sensor, sim)

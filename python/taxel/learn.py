@@ -16,6 +16,8 @@ cross-validation and Dietterich's 5x2cv paired t test on many threads.
 """
 from __future__ import annotations
 
+import difflib
+import functools
 import importlib
 import inspect
 import os
@@ -141,7 +143,7 @@ class _Classifier:
     # --- parameters -------------------------------------------------------------------------
     @classmethod
     def _param_names(cls) -> list[str]:
-        sig = inspect.signature(cls.__init__)
+        sig = inspect.signature(cls.__init__)  # follows __wrapped__ (_keyword_hints)
         return [p.name for p in sig.parameters.values() if p.kind == p.KEYWORD_ONLY]
 
     def get_params(self, deep: bool = True) -> dict[str, typing.Any]:
@@ -537,6 +539,29 @@ class Mlp(_Probabilistic):
         p["hidden"] = list(p["hidden"])
         return p
 
+
+def _keyword_hints(cls: typing.Any) -> None:
+    """A misspelled parameter names itself and the closest valid one."""
+    init = cls.__init__
+
+    @functools.wraps(init)
+    def __init__(self: typing.Any, *args: typing.Any, **kwargs: typing.Any) -> None:
+        valid = cls._param_names()
+        for k in kwargs:
+            if k not in valid:
+                close = difflib.get_close_matches(k, valid, n=1)
+                hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise TypeError(
+                    f"{cls.__name__}() got an unexpected keyword argument {k!r}{hint} "
+                    f"(its parameters: {', '.join(valid)})"
+                )
+        init(self, *args, **kwargs)
+
+    cls.__init__ = __init__
+
+
+for _cls in (LinearSvm, Knn, Lda, RbfSvm, Mlp):
+    _keyword_hints(_cls)
 
 _Estimator = typing.Union[LinearSvm, Knn, Lda, RbfSvm, Mlp]
 

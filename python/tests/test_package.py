@@ -3,13 +3,16 @@
 import ast
 import concurrent.futures
 import importlib
+import inspect
 import os
 import pathlib
 import re
+import shutil
 import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 import taxel
 
@@ -35,20 +38,88 @@ def test_version_and_submodules():
     assert importlib.import_module("taxel.image").segment is taxel._taxel.image.segment
 
 
-def test_every_public_callable_is_documented():
-    undocumented = []
-    for sub in ("fusion", "image", "io", "learn", "optical", "registration", "sensor", "sim"):
-        mod = getattr(taxel, sub)
+SUBMODULES = ("fusion", "image", "index", "io", "learn", "optical", "registration", "sensor", "sim")
+
+
+def _doc_text(obj, name):
+    """A member's documentation without pybind11's signature lines."""
+    if isinstance(obj, property):
+        doc = obj.__doc__ or (obj.fget.__doc__ if obj.fget else "") or ""
+    else:
+        doc = getattr(obj, "__doc__", "") or ""
+    signature = re.compile(rf"^(\d+\. )?{re.escape(name)}\(.*\) -> |^\(self: .*\) -> |^Overloaded function\.$")
+    return "\n".join(ln for ln in doc.splitlines() if ln.strip() and not signature.match(ln.strip()))
+
+
+def _public():
+    """(qualified name, object) of every public class, function and class member."""
+    seen = set()
+    for sub in ("",) + SUBMODULES:
+        mod = getattr(taxel, sub) if sub else taxel
         for name in dir(mod):
             obj = getattr(mod, name)
-            if name.startswith("_") or not callable(obj):
+            if name.startswith("_") or inspect.ismodule(obj) or id(obj) in seen:
                 continue
-            doc = obj.__doc__ or ""
-            signature = re.compile(rf"^(\d+\. )?{name}\(.*\) -> ")
-            text = "\n".join(ln for ln in doc.splitlines() if not signature.match(ln) and ln.strip())
-            if not text.strip():
-                undocumented.append(f"{sub}.{name}")
+            seen.add(id(obj))
+            if inspect.isclass(obj):
+                yield f"{sub}.{name}", name, obj
+                for attr, member in vars(obj).items():
+                    if not attr.startswith("_"):
+                        yield f"{sub}.{name}.{attr}", attr, member
+            elif callable(obj):
+                yield f"{sub}.{name}", name, obj
+
+
+def test_every_public_member_is_documented():
+    members = list(_public())
+    assert len(members) > 280
+    undocumented = [q for q, name, obj in members if not _doc_text(obj, name).strip()]
     assert undocumented == []
+
+
+def test_every_class_has_a_repr_of_its_own():
+    default = [q for q, _, obj in _public() if inspect.isclass(obj) and not issubclass(obj, BaseException)
+               and obj.__repr__ is object.__repr__]
+    assert default == []
+
+
+def test_a_misspelled_keyword_names_itself_and_its_neighbour():
+    with pytest.raises(TypeError) as e:
+        taxel.image.segment(np.zeros((8, 8)), min_aera=3)
+    assert str(e.value).startswith("segment() got an unexpected keyword argument 'min_aera'; did you mean 'min_area'?")
+    with pytest.raises(TypeError, match=r"ContactCloud.insert\(\) got an unexpected keyword argument 'sigmaa'"):
+        taxel.fusion.ContactCloud().insert(np.zeros((2, 3)), sigmaa=1e-3)
+    with pytest.raises(TypeError) as e:
+        taxel.image.segment(np.zeros((400, 400)).tolist(), k="three")
+    assert len(str(e.value)) < 400 and "got (list, k=str)" in str(e.value)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'Cc'; did you mean 'C'"):
+        taxel.learn.LinearSvm(Cc=1.0)
+
+
+def _mypy(*targets, strict=False):
+    if shutil.which("mypy") is None:
+        pytest.skip("mypy is not installed (Debian: mypy)")
+    config = pathlib.Path(os.environ.get("TMPDIR", "/tmp")) / f"taxel-mypy-{os.getpid()}.ini"
+    config.write_text("[mypy]\ncache_dir = /dev/null\n[mypy-matplotlib.*]\nignore_missing_imports = True\n")
+    try:
+        cmd = ["mypy", "--config-file", str(config), "--no-incremental"] + (["--strict"] if strict else []) + list(targets)
+        run = subprocess.run(cmd, capture_output=True, text=True, env=ENV, cwd=str(config.parent))
+    finally:
+        config.unlink()
+    assert run.returncode == 0, run.stdout + run.stderr
+
+
+def test_mypy_strict_on_the_package():
+    _mypy("-p", "taxel", strict=True)
+
+
+def test_mypy_on_the_examples_and_the_readme(tmp_path):
+    root = PACKAGE.parents[1]
+    blocks = re.findall(r"```python\n(.*?)```", (root / "README.md").read_text(), re.S)
+    assert blocks
+    readme = tmp_path / "readme_block.py"
+    readme.write_text("\n".join(blocks))
+    _mypy(str(root / "examples" / "python"), str(readme))
 
 
 def test_errors_are_python_exceptions():
