@@ -109,3 +109,24 @@ def test_contact_cloud_queries_match_ckdtree(rng, index_name):
     ref = spatial.cKDTree(means).query_ball_point(queries, 5e-3)
     for ours, theirs in zip(cloud.query_ball_point(queries, 5e-3), ref):
         assert sorted(ours.tolist()) == sorted(theirs)
+
+
+def test_point_cloud_arrays_are_read_only_views(rng):
+    import gc
+
+    import taxel
+
+    pts = rng.normal(size=(1000, 3))
+    normals = pts / np.linalg.norm(pts, axis=1, keepdims=True)
+    pc = taxel.PointCloud(pts, normals, {"w": np.arange(1000.0)})
+    a, b = pc.points, pc.points
+    assert np.shares_memory(a, b)  # no copy: both look at the cloud's memory
+    assert not np.shares_memory(a, pts)  # the constructor copied in
+    for view in (a, pc.normals, pc.fields["w"]):
+        assert not view.flags.writeable
+        with pytest.raises(ValueError, match="read-only"):
+            view[0] = 1.0
+    del pc
+    gc.collect()
+    np.testing.assert_array_equal(a, pts)  # the view keeps the cloud alive
+    np.testing.assert_array_equal(b[:, 0], pts[:, 0])
