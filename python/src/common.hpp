@@ -253,7 +253,10 @@ void pickle_members(py::class_<T>& cls, const char* name, Ms... members) {
 
 /// Pickling through a constructor: `args(t)` gives the arguments as a tuple, `make(tuple)`
 /// builds the object again; deep copies copy.
-template <class T, class Args, class Make>
+/// `Copy` false: copy.deepcopy goes through the pickled state (for a type whose copy
+/// constructor is declared but cannot be instantiated, such as one holding a vector of
+/// unique_ptr).
+template <bool Copy = true, class T, class Args, class Make>
 void pickle_with(py::class_<T>& cls, const char* name, Args args, Make make) {
   cls.def(py::pickle([args](const T& t) { return py::make_tuple(1, args(t)); },
                      [make, name](const py::tuple& s) {
@@ -263,7 +266,7 @@ void pickle_with(py::class_<T>& cls, const char* name, Args args, Make make) {
                        }
                        return make(s[1].cast<py::tuple>());
                      }));
-  if constexpr (std::is_copy_constructible_v<T>) {
+  if constexpr (Copy && std::is_copy_constructible_v<T>) {
     cls.def(
         "__deepcopy__", [](const T& t, const py::dict&) { return T(t); }, py::arg("memo"));
   }  // else copy.deepcopy goes through the pickled state

@@ -364,12 +364,16 @@ sigma_tilt [rad] are the per-frame noise of the pad pose. Defaults: a Weiss DSA 
       .def_property_readonly("rows", [](const sensor::SensorModel& m) { return m.geometry.rows; })
       .def_property_readonly("cols", [](const sensor::SensorModel& m) { return m.geometry.cols; })
       .def_property_readonly("pitch", [](const sensor::SensorModel& m) { return m.geometry.pitch; })
-      .def_readonly("full_scale_depth", &sensor::SensorModel::full_scale_depth, "indentation that saturates a tactel [m]")
+      .def_readonly("full_scale_depth", &sensor::SensorModel::full_scale_depth,
+                    "indentation that saturates a tactel [m]")
       .def_readonly("levels", &sensor::SensorModel::levels, "reading levels")
       .def_readonly("threshold", &sensor::SensorModel::threshold, "readings below this read 0")
-      .def_readonly("sigma_normal", &sensor::SensorModel::sigma_normal, "depth noise of a tactel [m]")
-      .def_readonly("sigma_position", &sensor::SensorModel::sigma_position, "per-frame pad translation noise [m]")
-      .def_readonly("sigma_tilt", &sensor::SensorModel::sigma_tilt, "per-frame pad tilt noise [rad]")
+      .def_readonly("sigma_normal", &sensor::SensorModel::sigma_normal,
+                    "depth noise of a tactel [m]")
+      .def_readonly("sigma_position", &sensor::SensorModel::sigma_position,
+                    "per-frame pad translation noise [m]")
+      .def_readonly("sigma_tilt", &sensor::SensorModel::sigma_tilt,
+                    "per-frame pad tilt noise [rad]")
       .def("depth_per_count", &sensor::SensorModel::depth_per_count, "depth of one count [m]")
       .def(
           "tactel",
@@ -411,11 +415,16 @@ centre's where the frame's quadric fits).)doc")
            py::arg("refine_censoring") = true, py::arg("tactel_area") = false)
       .def_property_readonly(
           "mode", [](const sensor::ContactOptions& o) { return enum_name(o.mode, kModes); })
-      .def_readonly("local_normals", &sensor::ContactOptions::local_normals, "normals from the pad's depth map (False: the pad normal)")
-      .def_readonly("correct_censoring", &sensor::ContactOptions::correct_censoring, "whether near-threshold readings are corrected")
-      .def_readonly("refine_censoring", &sensor::ContactOptions::refine_censoring, "whether the correction is taken at the quadric's depth")
-      .def_readonly("tactel_area", &sensor::ContactOptions::tactel_area, "whether a reading is the mean over the tactel's area")
-      .def_readonly("fallback_normal_sigma", &sensor::ContactOptions::fallback_normal_sigma, "slope uncertainty where the depth map has none [rad]");
+      .def_readonly("local_normals", &sensor::ContactOptions::local_normals,
+                    "normals from the pad's depth map (False: the pad normal)")
+      .def_readonly("correct_censoring", &sensor::ContactOptions::correct_censoring,
+                    "whether near-threshold readings are corrected")
+      .def_readonly("refine_censoring", &sensor::ContactOptions::refine_censoring,
+                    "whether the correction is taken at the quadric's depth")
+      .def_readonly("tactel_area", &sensor::ContactOptions::tactel_area,
+                    "whether a reading is the mean over the tactel's area")
+      .def_readonly("fallback_normal_sigma", &sensor::ContactOptions::fallback_normal_sigma,
+                    "slope uncertainty where the depth map has none [rad]");
 
   s.def("contacts_from_readings", &readings_to_contacts, py::arg("readings"), py::arg("poses"),
         py::kw_only(), py::arg("times") = py::none(), py::arg("model") = sensor::SensorModel{},
@@ -550,7 +559,8 @@ Options that the chosen policy or index does not use must stay at their defaults
           (std::string("Fused points within r (ids are rows of `means`). ") + kBallDoc).c_str())
       .def_readonly("policy", &PyContactCloud::policy, "the fusion policy's name")
       .def_readonly("index", &PyContactCloud::index, "the spatial index's name")
-      .def_readonly("association_radius", &PyContactCloud::association_radius, "the association gate [m]")
+      .def_readonly("association_radius", &PyContactCloud::association_radius,
+                    "the association gate [m]")
       .def("__len__",
            [](const PyContactCloud& c) {
              const auto lock = read_lock(&c);

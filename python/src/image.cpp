@@ -160,13 +160,15 @@ counter-clockwise with y up.)doc");
       .def_readonly("message", &im::KMeans1dResult::message, "why, when status is not 'ok'")
       .def_readonly("k", &im::KMeans1dResult::k,
                     "clusters found: min(k_requested, distinct values)")
-      .def_readonly("k_requested", &im::KMeans1dResult::k_requested, "the number of clusters asked for")
+      .def_readonly("k_requested", &im::KMeans1dResult::k_requested,
+                    "the number of clusters asked for")
       .def_readonly("centroids", &im::KMeans1dResult::centroids, "cluster centres, ascending")
       .def_readonly("lower", &im::KMeans1dResult::lower, "smallest value of each cluster")
       .def_readonly("upper", &im::KMeans1dResult::upper, "largest value of each cluster")
       .def_readonly("sizes", &im::KMeans1dResult::sizes, "values in each cluster")
       .def_readonly("sse", &im::KMeans1dResult::sse, "within-cluster sum of squared deviations")
-      .def_readonly("iterations", &im::KMeans1dResult::iterations, "Lloyd iterations (0 for the exact solver)")
+      .def_readonly("iterations", &im::KMeans1dResult::iterations,
+                    "Lloyd iterations (0 for the exact solver)")
       .def(
           "labels",
           [](const im::KMeans1dResult& r, const ArrayD& values) {
@@ -222,10 +224,13 @@ counter-clockwise with y up.)doc");
           "high", [](const im::Segmentation& s) { return s.high; },
           "uint8 mask of the HPR pixels after removal of small regions")
       .def_property_readonly("high_raw", [](const im::Segmentation& s) { return s.high_raw; })
-      .def_readonly("kmeans", &im::Segmentation::kmeans, "the clustering of the pixel values (KMeans1dResult)")
+      .def_readonly("kmeans", &im::Segmentation::kmeans,
+                    "the clustering of the pixel values (KMeans1dResult)")
       .def_readonly("regions", &im::Segmentation::regions, "HPR components kept")
-      .def_readonly("background_level", &im::Segmentation::background_level, "centroid of the background cluster")
-      .def_readonly("high_level", &im::Segmentation::high_level, "centroid of the high-pressure cluster")
+      .def_readonly("background_level", &im::Segmentation::background_level,
+                    "centroid of the background cluster")
+      .def_readonly("high_level", &im::Segmentation::high_level,
+                    "centroid of the high-pressure cluster")
       .def_readonly("pixel_min", &im::Segmentation::pixel_min, "smallest pixel value")
       .def_readonly("pixel_max", &im::Segmentation::pixel_max, "largest pixel value")
       .def_readonly("pixel_mean", &im::Segmentation::pixel_mean, "mean pixel value");

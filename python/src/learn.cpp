@@ -391,7 +391,8 @@ files.)doc");
                              [](const ln::CvReport& r) { return vector_array(r.classes); })
       .def_readonly("confusion", &ln::CvReport::confusion,
                     "[true class][predicted class], in `classes` order")
-      .def_readonly("per_class_accuracy", &ln::CvReport::per_class_accuracy, "recall of each class, in `classes` order")
+      .def_readonly("per_class_accuracy", &ln::CvReport::per_class_accuracy,
+                    "recall of each class, in `classes` order")
       .def_property_readonly("predicted",
                              [](const ln::CvReport& r) { return vector_array(r.predicted); })
       .def_property_readonly("fold", [](const ln::CvReport& r) { return vector_array(r.fold); });
@@ -444,12 +445,16 @@ files.)doc");
           },
           "(5, 2) error of A minus error of B per replication and fold")
       .def_readonly("t", &ln::FiveByTwoResult::t, "the 5x2cv t statistic")
-      .def_readonly("p_value", &ln::FiveByTwoResult::p_value, "two-sided p-value, Student t with 5 degrees of freedom")
+      .def_readonly("p_value", &ln::FiveByTwoResult::p_value,
+                    "two-sided p-value, Student t with 5 degrees of freedom")
       .def_readonly("alpha", &ln::FiveByTwoResult::alpha, "significance level")
       .def_readonly("critical", &ln::FiveByTwoResult::critical, "|t| above this rejects")
-      .def_readonly("reject", &ln::FiveByTwoResult::reject, "whether equal error rates are rejected")
-      .def_readonly("mean_error_a", &ln::FiveByTwoResult::mean_error_a, "mean error rate of A over the ten folds")
-      .def_readonly("mean_error_b", &ln::FiveByTwoResult::mean_error_b, "mean error rate of B over the ten folds");
+      .def_readonly("reject", &ln::FiveByTwoResult::reject,
+                    "whether equal error rates are rejected")
+      .def_readonly("mean_error_a", &ln::FiveByTwoResult::mean_error_a,
+                    "mean error rate of A over the ten folds")
+      .def_readonly("mean_error_b", &ln::FiveByTwoResult::mean_error_b,
+                    "mean error rate of B over the ten folds");
 
   m.def(
       "five_by_two_t_test",

@@ -9,12 +9,12 @@ PYBIND11_MODULE(_taxel, m) {
   m.doc() = "taxel: tactile perception (the compiled part of the taxel package)";
   m.attr("__version__") = TAXEL_VERSION_STRING;
   // File and format errors are OSErrors whose message names the file, the line and the reason.
-  pybind11::register_exception<taxel::IoError>(m, "IoError", PyExc_OSError)
-      .doc() = "A file or data format error (an OSError): the message names the file, the line "
-               "or byte, and the reason.";
-  pybind11::register_exception<taxel::ProtocolError>(m, "ProtocolError", PyExc_OSError)
-      .doc() = "A device answered outside its protocol (an OSError naming the device and the "
-               "reply).";
+  pybind11::register_exception<taxel::IoError>(m, "IoError", PyExc_OSError).doc() =
+      "A file or data format error (an OSError): the message names the file, the line "
+      "or byte, and the reason.";
+  pybind11::register_exception<taxel::ProtocolError>(m, "ProtocolError", PyExc_OSError).doc() =
+      "A device answered outside its protocol (an OSError naming the device and the "
+      "reply).";
   tp::bind_core(m);
   tp::bind_fusion(m);
   tp::bind_index(m);

@@ -249,10 +249,36 @@ RuntimeError naming a press without contact.)doc");
       py::arg("frames"),
       "The per-pixel median of frames that mostly show the untouched gel, as a background.");
 
-  py::class_<Reconstructor>(o, "Reconstructor", R"doc(
+  py::class_<Reconstructor> cls_reconstructor(o, "Reconstructor", R"doc(
 Frames to height maps with one calibration: keeps the Poisson solver of the calibration's frame
 size, so that a stream of frames does not plan it again. Calls on one reconstructor run one at
-a time; use one per thread to run them together.)doc")
+a time; use one per thread to run them together.)doc");
+  pickle_with<false>(
+      cls_reconstructor, "Reconstructor",
+      [](const Reconstructor& r) {
+        const auto lock = read_lock(&r);
+        // The calibration, and its background as it has drifted, in full precision (the file
+        // keeps it to 8 bits); the solver is a cache.
+        const auto& bg = r.calibration.background;
+        return py::make_tuple(py::bytes(to::encode_calibration(r.calibration)), r.drift_rate, bg[0],
+                              bg[1], bg[2]);
+      },
+      [](const py::tuple& a) {
+        if (a.size() != 5) throw py::value_error("Reconstructor: damaged pickled state");
+        Reconstructor r(to::decode_calibration(std::string_view(a[0].cast<py::bytes>()),
+                                               "pickled Reconstructor"),
+                        a[1].cast<double>());
+        for (std::size_t c = 0; c < 3; ++c) {
+          auto plane = a[2 + c].cast<to::Plane>();
+          if (plane.rows() != r.calibration.background[c].rows() ||
+              plane.cols() != r.calibration.background[c].cols()) {
+            throw py::value_error("Reconstructor: the pickled background's size is wrong");
+          }
+          r.calibration.background[c] = std::move(plane);
+        }
+        return r;
+      });
+  cls_reconstructor
       .def(py::init(
                [](const CalPtr& c, double drift_rate) { return Reconstructor(*c, drift_rate); }),
            py::arg("calibration"), py::kw_only(), py::arg("drift_rate") = 0.0,
@@ -346,9 +372,45 @@ deepest height). Raises ValueError for a frame of another size or one with no ge
       py::arg("frame"),
       "The marker dots of a frame, (dots, 3): centre column, centre row [px] and area [px].");
 
-  py::class_<to::MarkerTracker>(o, "MarkerTracker", R"doc(
+  py::class_<to::MarkerTracker> cls_markertracker(o, "MarkerTracker", R"doc(
 Follows marker dots from a frame of the gel at rest through later frames, as a displacement
-field: lost dots are placed by their neighbours' motion, new dots start new tracks.)doc")
+field: lost dots are placed by their neighbours' motion, new dots start new tracks.)doc");
+  pickle_with(
+      cls_markertracker, "MarkerTracker",
+      [](const to::MarkerTracker& t) {
+        const auto lock = read_lock(&t);
+        ArrayD rows({static_cast<py::ssize_t>(t.tracks().size()), py::ssize_t{6}});
+        double* p = rows.mutable_data();
+        for (const auto& k : t.tracks()) {
+          *p++ = k.x0;
+          *p++ = k.y0;
+          *p++ = k.x;
+          *p++ = k.y;
+          *p++ = k.seen ? 1.0 : 0.0;
+          *p++ = k.missed;
+        }
+        return py::make_tuple(t.options().max_step, t.options().neighbours, rows);
+      },
+      [](const py::tuple& a) {
+        if (a.size() != 3) throw py::value_error("MarkerTracker: damaged pickled state");
+        const auto rows = a[2].cast<ArrayD>();
+        require_shape(rows, {-1, 6}, "pickled tracks", "(N, 6)");
+        std::vector<to::MarkerTrack> tracks(static_cast<std::size_t>(rows.shape(0)));
+        const double* p = rows.data();
+        for (auto& k : tracks) {
+          k = {p[0], p[1], p[2], p[3], p[4] != 0.0, static_cast<int>(p[5])};
+          p += 6;
+        }
+        to::TrackerOptions options;
+        options.max_step = a[0].cast<double>();
+        options.neighbours = a[1].cast<int>();
+        try {
+          return to::MarkerTracker::restore(std::move(tracks), options);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+      });
+  cls_markertracker
       .def(py::init([](const ArrayD& dots, double max_step) {
              return to::MarkerTracker(dots_from(dots), {.max_step = max_step});
            }),

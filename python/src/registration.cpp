@@ -67,15 +67,51 @@ double default_scale(const std::string& kernel) {
   }
 }
 
+/// A target's points, normals and configuration: what a pickled Target is made again from.
+py::tuple target_state(const reg::Target<double>& t) {
+  const reg::TargetConfig& c = t.config();
+  return py::make_tuple(points_array(t.points()), points_array(t.normals()), c.normal_neighbors,
+                        c.grid_spacing_factor, c.field_cell, c.field_margin, c.field_max_cells);
+}
+
+/// The target of target_state(): the normals as they were, not estimated again.
+reg::Target<double> target_from(const py::tuple& a) {
+  if (a.size() != 7) throw py::value_error("Target: damaged pickled state");
+  reg::TargetConfig c;
+  c.normal_neighbors = a[2].cast<int>();
+  c.grid_spacing_factor = a[3].cast<double>();
+  c.field_cell = a[4].cast<double>();
+  c.field_margin = a[5].cast<double>();
+  c.field_max_cells = a[6].cast<std::size_t>();
+  Cloud cloud = cloud_from(a[0].cast<ArrayD>(), a[1].cast<ArrayD>(), "pickled points");
+  py::gil_scoped_release release;
+  return reg::Target<double>(std::move(cloud), c);
+}
+
+/// Pickling (version 1) for a class whose state is one tuple.
+template <class T, class Get, class Set>
+void pickle_state(py::class_<T>& cls, const char* name, Get get, Set set) {
+  cls.def(py::pickle([get](const T& t) { return py::make_tuple(1, get(t)); },
+                     [set, name](const py::tuple& s) {
+                       if (s.size() != 2 || s[0].cast<int>() != 1) {
+                         throw py::value_error(std::string(name) +
+                                               ": not a pickled state of version 1");
+                       }
+                       return set(s[1].cast<py::tuple>());
+                     }));
+}
+
 }  // namespace
 
 void bind_registration(py::module_& root) {
   py::module_ m = root.def_submodule("registration", "ICP alignment and object recognition");
 
-  py::class_<reg::Target<double>>(m, "Target", R"doc(
+  py::class_<reg::Target<double>> target_cls(m, "Target", R"doc(
 A model prepared for registration: points [m], unit normals (given, or estimated by PCA over
 `normal_neighbors` points and oriented away from the centroid), a nearest-neighbour grid and,
-with field_cell > 0 [m], a closest-point field for approximate correspondences.)doc")
+with field_cell > 0 [m], a closest-point field for approximate correspondences.)doc");
+  pickle_state(target_cls, "Target", target_state, target_from);
+  target_cls
       .def(py::init([](const ArrayD& points, const std::optional<ArrayD>& normals,
                        int normal_neighbors, bool recompute_normals, double grid_spacing_factor,
                        double field_cell, double field_margin, std::size_t field_max_cells) {
@@ -144,8 +180,10 @@ with field_cell > 0 [m], a closest-point field for approximate correspondences.)
           "transform", [](const reg::IcpResult& r) { return pose_array(r.transform); },
           "T_target_source, a 4x4 matrix")
       .def_readonly("rmse", &reg::IcpResult::rmse, "RMS distance of the inlier pairs [m]")
-      .def_readonly("inlier_fraction", &reg::IcpResult::inlier_fraction, "inliers / finite source points")
-      .def_readonly("inliers", &reg::IcpResult::inliers, "pairs kept by the distance gate and trimming")
+      .def_readonly("inlier_fraction", &reg::IcpResult::inlier_fraction,
+                    "inliers / finite source points")
+      .def_readonly("inliers", &reg::IcpResult::inliers,
+                    "pairs kept by the distance gate and trimming")
       .def_readonly("skipped", &reg::IcpResult::skipped, "non-finite source points ignored")
       .def_readonly("iterations", &reg::IcpResult::iterations, "updates applied")
       .def("__repr__", [](const reg::IcpResult& r) {
@@ -228,7 +266,8 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
       .def_readonly("model", &reg::ModelMatch::model, "index in the library")
       .def_readonly("score", &reg::ModelMatch::score, "truncated RMS distance [m], lower is better")
       .def_readonly("rmse", &reg::ModelMatch::rmse, "ICP inlier RMS distance [m]")
-      .def_readonly("inlier_fraction", &reg::ModelMatch::inlier_fraction, "ICP inliers / cloud points")
+      .def_readonly("inlier_fraction", &reg::ModelMatch::inlier_fraction,
+                    "ICP inliers / cloud points")
       .def_property_readonly(
           "transform", [](const reg::ModelMatch& r) { return pose_array(r.transform); },
           "T_model_cloud, a 4x4 matrix")
@@ -254,7 +293,8 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
       .def_readonly("message", &reg::ObjectRecognition::message, "why, when status is not 'ok'")
       .def_readonly("ranking", &reg::ObjectRecognition::ranking, "ModelMatch list, best first")
       .def_readonly("best", &reg::ObjectRecognition::best, "the best model's name, or 'unknown'")
-      .def_readonly("unknown", &reg::ObjectRecognition::unknown, "no model fits within the threshold")
+      .def_readonly("unknown", &reg::ObjectRecognition::unknown,
+                    "no model fits within the threshold")
       .def_readonly("margin", &reg::ObjectRecognition::margin,
                     "second score - best score [m] (0 with one model)")
       .def("__repr__", [](const reg::ObjectRecognition& r) {
@@ -262,10 +302,62 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
       });
 
   const reg::LibraryConfig kLib{};
-  py::class_<reg::ObjectLibrary<double>>(m, "ObjectLibrary", R"doc(
+  py::class_<reg::ObjectLibrary<double>> library_cls(m, "ObjectLibrary", R"doc(
 Named object models; recognize() ranks them by how well each explains a cloud (multi-start
 point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its starts out over
-`threads` threads (0: every core); the answer does not depend on the number.)doc")
+`threads` threads (0: every core); the answer does not depend on the number.)doc");
+  pickle_state(
+      library_cls, "ObjectLibrary",
+      [](const reg::ObjectLibrary<double>& lib) {
+        const auto lock = read_lock(&lib);
+        const reg::LibraryConfig& c = lib.config();
+        py::list models;
+        for (std::size_t i = 0; i < lib.size(); ++i) {
+          models.append(py::make_tuple(lib.name(i), target_state(lib.target(i))));
+        }
+        return py::make_tuple(
+            py::make_tuple(c.coarse_iterations, c.coarse_points, c.refine_points, c.coarse_trim,
+                           c.pca_starts, c.rotation_starts, c.refine_best, c.exact_models,
+                           c.hopeless_factor, c.field_cell, c.score_gate, c.unknown_score,
+                           c.threads),
+            models);
+      },
+      [](const py::tuple& a) {
+        const auto c = a[0].cast<py::tuple>();
+        if (a.size() != 2 || c.size() != 13) {
+          throw py::value_error("ObjectLibrary: damaged pickled state");
+        }
+        reg::LibraryConfig cfg;
+        cfg.coarse_iterations = c[0].cast<int>();
+        cfg.coarse_points = c[1].cast<std::size_t>();
+        cfg.refine_points = c[2].cast<std::size_t>();
+        cfg.coarse_trim = c[3].cast<double>();
+        cfg.pca_starts = c[4].cast<bool>();
+        cfg.rotation_starts = c[5].cast<int>();
+        cfg.refine_best = c[6].cast<int>();
+        cfg.exact_models = c[7].cast<int>();
+        cfg.hopeless_factor = c[8].cast<double>();
+        cfg.field_cell = c[9].cast<double>();
+        cfg.score_gate = c[10].cast<double>();
+        cfg.unknown_score = c[11].cast<double>();
+        cfg.threads = c[12].cast<unsigned>();
+        reg::ObjectLibrary<double> lib(cfg);
+        for (const auto& item : a[1].cast<py::list>()) {
+          const auto model = item.cast<py::tuple>();
+          const auto t = model[1].cast<py::tuple>();
+          if (t.size() != 7) throw py::value_error("ObjectLibrary: damaged pickled model");
+          reg::TargetConfig tc;
+          tc.normal_neighbors = t[2].cast<int>();
+          tc.grid_spacing_factor = t[3].cast<double>();
+          tc.field_cell = t[4].cast<double>();
+          tc.field_margin = t[5].cast<double>();
+          tc.field_max_cells = t[6].cast<std::size_t>();
+          lib.add(model[0].cast<std::string>(),
+                  cloud_from(t[0].cast<ArrayD>(), t[1].cast<ArrayD>(), "pickled model"), tc);
+        }
+        return lib;
+      });
+  library_cls
       .def(py::init([](int coarse_iterations, std::size_t coarse_points, std::size_t refine_points,
                        double coarse_trim, bool pca_starts, int rotation_starts, int refine_best,
                        int exact_models, double hopeless_factor, double field_cell,

@@ -176,7 +176,8 @@ palm-grasp pressure-image synthesiser.)doc");
   torus
       .def(py::init<double, double>(), py::arg("major_radius") = 0.04,
            py::arg("minor_radius") = 0.015)
-      .def_readonly("major_radius", &sm::Torus::major_radius, "distance from the axis to the tube's centre [m]")
+      .def_readonly("major_radius", &sm::Torus::major_radius,
+                    "distance from the axis to the tube's centre [m]")
       .def_readonly("minor_radius", &sm::Torus::minor_radius, "the tube's radius [m]");
   shape_methods(torus);
   py::class_<sm::TriangleMesh> mesh(m, "TriangleMesh",
@@ -253,8 +254,45 @@ palm-grasp pressure-image synthesiser.)doc");
       "Distances [m] of (N, 3) points to the surface of `shape` placed at object_pose: "
       "'signed_mean' (outside positive), 'mean' |d|, 'rms', 'max' |d|.");
 
-  py::class_<PyExploration>(m, "Exploration", "Frames of pad readings, poses and contacts.")
-      .def("__len__", [](const PyExploration& e) { return e.frames.size(); })
+  py::class_<PyExploration> cls_exploration(m, "Exploration",
+                                            "Frames of pad readings, poses and contacts.");
+  pickle_with(
+      cls_exploration, "Exploration",
+      [](const PyExploration& e) {
+        py::list frames;
+        for (const auto& f : e.frames) {
+          py::list pads;
+          for (const auto& p : f.pads) {
+            pads.append(py::make_tuple(p.pad, p.counts, detail::pickled(p.true_pose),
+                                       detail::pickled(p.believed_pose)));
+          }
+          frames.append(py::make_tuple(f.time, pads, ContactList(f.contacts)));
+        }
+        return py::make_tuple(detail::pickled(e.object_pose), frames);
+      },
+      [](const py::tuple& a) {
+        if (a.size() != 2) throw py::value_error("Exploration: damaged pickled state");
+        PyExploration e;
+        detail::unpickled(e.object_pose, a[0]);
+        for (const auto& f : a[1].cast<py::list>()) {
+          const auto t = f.cast<py::tuple>();
+          sm::ExplorationFrame frame;
+          frame.time = t[0].cast<double>();
+          for (const auto& p : t[1].cast<py::list>()) {
+            const auto q = p.cast<py::tuple>();
+            sm::PadReading r;
+            r.pad = q[0].cast<int>();
+            r.counts = q[1].cast<decltype(r.counts)>();
+            detail::unpickled(r.true_pose, q[2]);
+            detail::unpickled(r.believed_pose, q[3]);
+            frame.pads.push_back(std::move(r));
+          }
+          frame.contacts = t[2].cast<ContactList>();
+          e.frames.push_back(std::move(frame));
+        }
+        return e;
+      });
+  cls_exploration.def("__len__", [](const PyExploration& e) { return e.frames.size(); })
       .def_property_readonly("object_pose",
                              [](const PyExploration& e) { return pose_array(e.object_pose); })
       .def_property_readonly(

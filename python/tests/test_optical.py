@@ -180,3 +180,17 @@ def test_calibrations_pickle_and_copy(rig):
     b = optical.reconstruct(presses[0], again)
     np.testing.assert_array_equal(a["height"], b["height"])
     assert copy.deepcopy(cal) is cal  # immutable
+
+
+def test_a_drifting_reconstructor_pickles_with_its_background(rig):
+    import pickle
+
+    _, background, presses, _, cal = rig
+    r = optical.Reconstructor(cal, drift_rate=0.2)
+    brighter = np.clip(background.astype(int) + 6, 0, 255).astype(np.uint8)
+    for _ in range(3):
+        r(brighter)
+    twin = pickle.loads(pickle.dumps(r))
+    assert twin.drift_rate == r.drift_rate
+    a, b = r(presses[1]), twin(presses[1])
+    np.testing.assert_array_equal(a["height"], b["height"])

@@ -163,6 +163,29 @@ class MarkerTracker {
 
   /// The tracks, the reference's dots first in their order, then the dots found later.
   const std::vector<MarkerTrack>& tracks() const { return tracks_; }
+  /// The options, max_step resolved (never 0).
+  const TrackerOptions& options() const { return options_; }
+
+  /// A tracker that goes on from `tracks` and `options` as saved from another (tracks(),
+  /// options()). Throws std::invalid_argument for fewer than two tracks, a position that is not
+  /// finite, a negative miss count or options out of range (max_step must be > 0).
+  static MarkerTracker restore(std::vector<MarkerTrack> tracks, const TrackerOptions& options) {
+    if (tracks.size() < 2 || options.neighbours < 1 || !(options.max_step > 0) ||
+        !std::isfinite(options.max_step)) {
+      throw std::invalid_argument(
+          "MarkerTracker::restore: two tracks or more, neighbours >= 1 and a finite max_step > 0");
+    }
+    for (const MarkerTrack& t : tracks) {
+      if (!std::isfinite(t.x0) || !std::isfinite(t.y0) || !std::isfinite(t.x) ||
+          !std::isfinite(t.y) || t.missed < 0) {
+        throw std::invalid_argument("MarkerTracker::restore: a track is not finite");
+      }
+    }
+    MarkerTracker out;
+    out.options_ = options;
+    out.tracks_ = std::move(tracks);
+    return out;
+  }
   /// The pairing distance in use [px].
   double max_step() const { return options_.max_step; }
 
@@ -325,6 +348,8 @@ class MarkerTracker {
     }
     return {su / sw, sv / sw};
   }
+
+  MarkerTracker() = default;
 
   TrackerOptions options_;
   std::vector<MarkerTrack> tracks_;

@@ -54,14 +54,21 @@ class Target {
   /// Throws std::invalid_argument when the cloud is empty, a point or normal is not finite, a
   /// given normal is zero or the normals do not match the points, or normal_neighbors < 3.
   explicit Target(PointCloud<S> cloud, TargetConfig cfg = {})
-      : grid_(checked(cloud, cfg),
+      : cfg_(cfg),
+        grid_(checked(cloud, cfg),
               typename index::UniformGrid<S>::Config{S(0), std::size_t{1} << 22,
                                                      cfg.grid_spacing_factor}),
         tree_(grid_.points()) {
     const std::vector<Vec3<S>>& pts = grid_.points();
     if (cloud.has_normals() && !cfg.recompute_normals) {
       normals_ = std::move(cloud.normals);
-      for (auto& n : normals_) n.normalize();
+      // Normals already of unit length (to rounding) stay as they are, so that a target made
+      // again from another's normals (a pickled one) has the same ones to the bit.
+      for (auto& n : normals_) {
+        if (std::abs(n.squaredNorm() - S(1)) > S(64) * std::numeric_limits<S>::epsilon()) {
+          n.normalize();
+        }
+      }
     }
     Vec3<double> sum = Vec3<double>::Zero();
     for (const auto& p : pts) sum += p.template cast<double>();
@@ -86,6 +93,8 @@ class Target {
     if (cfg.field_cell > 0.0) build_field(cfg.field_cell, cfg.field_margin, cfg.field_max_cells);
   }
 
+  /// The configuration it was built with.
+  [[nodiscard]] const TargetConfig& config() const noexcept { return cfg_; }
   /// Number of points.
   [[nodiscard]] std::size_t size() const noexcept { return grid_.size(); }
   /// The points [m].
@@ -298,6 +307,7 @@ class Target {
   // kd-tree's.
   static constexpr double kHintCells = 1.0;
 
+  TargetConfig cfg_;
   index::UniformGrid<S> grid_;  // owns the points
   index::KdTree<S> tree_;
   std::vector<index::PointId> field_;  // closest-point field, x fastest
