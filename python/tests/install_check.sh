@@ -16,7 +16,7 @@ cloud.insert(sim.Sphere(0.03).sample_surface(500, 1).points, sigma=2e-4)
 assert 0 < len(cloud) < 500
 from taxel import learn
 x = np.random.default_rng(1).normal(size=(40, 3)); y = np.arange(40) % 2; x[y == 1] += 3
-assert learn.LinearSvm().fit(x, y).score(x, y) > 0.9
+assert learn.LinearSvm(bias=1.0).fit(x, y).score(x, y) > 0.9
 print("taxel", taxel.__version__, "from", taxel.__file__, ":", cloud)
 '
 case "$how" in
