@@ -31,11 +31,49 @@ import numpy.typing as npt
 # The compiled classifiers (taxel._taxel.learn), typed as Any for the type checker.
 _cpp: typing.Any = importlib.import_module("taxel._taxel").learn
 
-CvReport = _cpp.CvReport
-FiveByTwoResult = _cpp.FiveByTwoResult
-five_by_two_t_test = _cpp.five_by_two_t_test
-read_libsvm = _cpp.read_libsvm
-write_libsvm = _cpp.write_libsvm
+if typing.TYPE_CHECKING:
+
+    class CvReport(typing.Protocol):
+        """Out-of-fold results of cross_validate."""
+
+        status: str
+        message: str
+        accuracy: float
+        classes: npt.NDArray[np.int32]
+        confusion: npt.NDArray[np.int32]
+        per_class_accuracy: npt.NDArray[np.float64]
+        predicted: npt.NDArray[np.int32]
+        fold: npt.NDArray[np.int32]
+
+    class FiveByTwoResult(typing.Protocol):
+        """Dietterich's 5x2cv paired t test."""
+
+        status: str
+        message: str
+        differences: npt.NDArray[np.float64]
+        t: float
+        p_value: float
+        alpha: float
+        critical: float
+        reject: bool
+        mean_error_a: float
+        mean_error_b: float
+
+    def five_by_two_t_test(differences: npt.ArrayLike, alpha: float = 0.05) -> FiveByTwoResult:
+        """The 5x2cv t statistic, p-value and decision from the (5, 2) error differences."""
+
+    def read_libsvm(path: str) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]:
+        """(X, y) from a LIBSVM/LIBLINEAR data file (OSError naming the line)."""
+
+    def write_libsvm(path: str, X: npt.ArrayLike, y: npt.ArrayLike) -> None:
+        """Writes X and y as a LIBSVM data file."""
+
+else:
+    CvReport = _cpp.CvReport
+    FiveByTwoResult = _cpp.FiveByTwoResult
+    five_by_two_t_test = _cpp.five_by_two_t_test
+    read_libsvm = _cpp.read_libsvm
+    write_libsvm = _cpp.write_libsvm
 
 __all__ = [
     "CvReport",
@@ -588,15 +626,15 @@ def cross_validate(
     snr_db: float = float("inf"),
     noise_target: str = "test_only",
     threads: int = 0,
-) -> typing.Any:
+) -> CvReport:
     """Stratified k-fold cross-validation of a classifier's parameters (integer labels); grouped
     keeps each group in one fold; snr_db adds white noise to the test (or both) features. The
     folds train on `threads` threads (0: every core); the report does not depend on it. Returns
     a CvReport."""
-    return _cpp.cross_validate(
+    return typing.cast(CvReport, _cpp.cross_validate(
         _prototype(model), X, y, groups, folds=folds, seed=seed, grouped=grouped,
         snr_db=snr_db, noise_target=noise_target, threads=threads,
-    )
+    ))
 
 
 def five_by_two_cv(
@@ -612,11 +650,11 @@ def five_by_two_cv(
     snr_db: float = float("inf"),
     noise_target: str = "test_only",
     threads: int = 0,
-) -> typing.Any:
+) -> FiveByTwoResult:
     """Dietterich's 5x2cv paired t test of two classifiers' parameters on the same splits
     (integer labels); the ten rounds run on `threads` threads (0: every core). Returns a
     FiveByTwoResult."""
-    return _cpp.five_by_two_cv(
+    return typing.cast(FiveByTwoResult, _cpp.five_by_two_cv(
         _prototype(a), _prototype(b), X, y, groups, alpha=alpha, seed=seed, grouped=grouped,
         snr_db=snr_db, noise_target=noise_target, threads=threads,
-    )
+    ))
