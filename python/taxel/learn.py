@@ -254,8 +254,9 @@ class _Classifier:
         return self
 
     def _set_model(self, model: typing.Any, classes: _Array) -> None:
-        order = np.argsort(np.asarray(model.classes_))
-        self._order = order
+        labels = np.asarray(model.classes_)
+        self._order = np.argsort(labels)
+        self._labels = labels[self._order]  # the compiled model's labels, ascending
         self.classes_ = classes
         self.n_features_in_ = int(model.n_features_in_)
         self.model_ = model
@@ -278,7 +279,7 @@ class _Classifier:
         x = _features(X, type(self).__name__, self.n_features_in_)
         # The compiled model's labels, as positions in classes_ (both ascending).
         raw = np.asarray(model.predict(x))
-        position = np.searchsorted(np.sort(np.asarray(model.classes_)), raw)
+        position = np.searchsorted(self._labels, raw)
         return typing.cast(_Array, self.classes_[position])
 
     def decision_function(self, X: npt.ArrayLike) -> _Array:
