@@ -9,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -76,23 +77,45 @@ inline void running_max(const std::vector<double>& x, int reach, std::vector<dou
 
 // The running maximum over (2 reach + 1)^2 squares (clipped at the borders) of a plane: along
 // each row, then along the columns a whole row at a time.
-inline Plane running_max_2d(const Plane& x, int reach) {
-  const auto rows = static_cast<int>(x.rows()), cols = static_cast<int>(x.cols());
-  Plane across(rows, cols), out(rows, cols);
-  std::vector<double> line, g, h, res;
-  for (int r = 0; r < rows; ++r) {
-    line.assign(x.row(r).data(), x.row(r).data() + cols);
-    running_max(line, reach, g, h, res);
-    std::copy(res.begin(), res.end(), across.row(r).data());
+// The mask grown by one pixel to its 4-neighbours (rows and columns shifted, whole rows at a
+// time, which Eigen vectorises).
+inline image::Mask dilate4(const image::Mask& m) {
+  const Eigen::Index rows = m.rows(), cols = m.cols();
+  image::Mask out = m;
+  if (rows > 1) {
+    out.topRows(rows - 1) = out.topRows(rows - 1).max(m.bottomRows(rows - 1));
+    out.bottomRows(rows - 1) = out.bottomRows(rows - 1).max(m.topRows(rows - 1));
   }
-  Plane gp(rows, cols), hp(rows, cols);
+  if (cols > 1) {
+    out.leftCols(cols - 1) = out.leftCols(cols - 1).max(m.rightCols(cols - 1));
+    out.rightCols(cols - 1) = out.rightCols(cols - 1).max(m.leftCols(cols - 1));
+  }
+  return out;
+}
+
+// The running maximum down each column of x (rows i - reach .. i + reach, clipped): van Herk's
+// passes on whole rows, which Eigen vectorises.
+template <class A>
+A running_max_columns(const A& x, int reach) {
+  const auto rows = static_cast<int>(x.rows());
+  A gp(x.rows(), x.cols()), hp(x.rows(), x.cols()), out(x.rows(), x.cols());
   using Row = decltype(out.row(0));
   van_herk(
-      rows, reach, [&](int i) { return across.row(i); }, [&](int i) { return gp.row(i); },
+      rows, reach, [&](int i) { return x.row(i); }, [&](int i) { return gp.row(i); },
       [&](int i) { return hp.row(i); }, [&](int i) { return out.row(i); },
-      [](Row to, const auto& a, const auto& b) { to = a.max(b); },
-      [](Row to, const auto& a) { to = a; });
+      [](Row to, const auto& p, const auto& q) { to = p.max(q); },
+      [](Row to, const auto& p) { to = p; });
   return out;
+}
+
+// The maximum over the (2 reach + 1)^2 square around each pixel, clipped at the borders, of a
+// row-major Eigen array: down the columns of the transpose (along the rows), then down the
+// columns, so that both passes run on whole rows.
+template <class A>
+A running_max_2d(const A& x, int reach) {
+  const A t = x.transpose();
+  const A across = running_max_columns(t, reach).transpose();
+  return running_max_columns(across, reach);
 }
 }  // namespace detail
 
@@ -112,29 +135,23 @@ image::Mask marker_mask(const RgbFrame& frame, const MarkerOptions& o = {}) {
     throw std::invalid_argument("marker_mask: dark in (0, 1), reach >= 1 and grow >= 0");
   }
   const auto rows = static_cast<int>(frame.rows), cols = static_cast<int>(frame.cols);
-  Plane lum(rows, cols);
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      const std::uint8_t* p = frame.data.data() + (static_cast<std::size_t>(r) * cols + c) * 3;
-      lum(r, c) = (double(p[0]) + p[1] + p[2]) / 3.0;
-    }
+  // Luminance as the sum of the channels (0..765): 16-bit integers, whose running maximum
+  // vectorises 8 wide, and the same comparison as of the channels' mean.
+  image::Image<std::int16_t> sum(rows, cols);
+  const std::uint8_t* p = frame.data.data();
+  for (Eigen::Index i = 0; i < sum.size(); ++i, p += 3) {
+    sum.data()[i] = static_cast<std::int16_t>(p[0] + p[1] + p[2]);
   }
-  const Plane brightest = detail::running_max_2d(lum, o.reach);
+  const image::Image<std::int16_t> brightest = detail::running_max_2d(sum, o.reach);
+  // A dot pixel: sum < dark * brightest, that is sum < first[brightest], the least whole sum
+  // that is not darker (a table over the 766 possible maxima).
+  std::int16_t first[766];
+  for (int m = 0; m < 766; ++m) first[m] = static_cast<std::int16_t>(std::ceil(o.dark * m));
   image::Mask mask(rows, cols);
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) mask(r, c) = lum(r, c) < o.dark * brightest(r, c) ? 1 : 0;
+  for (Eigen::Index i = 0; i < sum.size(); ++i) {
+    mask.data()[i] = sum.data()[i] < first[brightest.data()[i]] ? 1 : 0;
   }
-  for (int step = 0; step < o.grow; ++step) {
-    const image::Mask m = mask;
-    for (int r = 0; r < rows; ++r) {
-      for (int c = 0; c < cols; ++c) {
-        if (!m(r, c) && ((r > 0 && m(r - 1, c)) || (r + 1 < rows && m(r + 1, c)) ||
-                         (c > 0 && m(r, c - 1)) || (c + 1 < cols && m(r, c + 1)))) {
-          mask(r, c) = 1;
-        }
-      }
-    }
-  }
+  for (int step = 0; step < o.grow; ++step) mask = detail::dilate4(mask);
   return mask;
 }
 

@@ -85,10 +85,14 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
   image::Mask dots;
   if (cal.markers) {
     dots = marker_mask(frame, cal.marker);
-    if (cal.background_markers.size() == dots.size()) {
-      dots = (dots != 0 || cal.background_markers != 0).cast<std::uint8_t>();
+    // The background's dots too; no colour change where a dot is, in one pass.
+    const bool known = cal.background_markers.size() == dots.size();
+    for (Eigen::Index i = 0; i < dots.size(); ++i) {
+      if (known && cal.background_markers.data()[i]) dots.data()[i] = 1;
+      if (dots.data()[i]) {
+        for (Plane& ch : change) ch.data()[i] = 0.0;
+      }
     }
-    for (Plane& ch : change) ch = (dots != 0).select(0.0, ch);
   }
   out.mask = touched_mask(change, cal.threshold, min_area);
   // The mask's bounding box, grown with it: the loops below stay inside it.
@@ -108,17 +112,9 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
     c0 = std::max(c0 - 1, 0);
     r1 = std::min(r1 + 1, cal.rows - 1);
     c1 = std::min(c1 + 1, cal.cols - 1);
-    const image::Mask m = grown.block(r0, c0, r1 - r0 + 1, c1 - c0 + 1);
+    // The box holds the mask with a pixel to spare: growing it there grows the whole mask.
     const int h = r1 - r0 + 1, w = c1 - c0 + 1;
-    for (int r = 0; r < h; ++r) {
-      for (int c = 0; c < w; ++c) {
-        if (m(r, c)) continue;
-        if ((r > 0 && m(r - 1, c)) || (r + 1 < h && m(r + 1, c)) || (c > 0 && m(r, c - 1)) ||
-            (c + 1 < w && m(r, c + 1))) {
-          grown(r0 + r, c0 + c) = 1;
-        }
-      }
-    }
+    grown.block(r0, c0, h, w) = detail::dilate4(grown.block(r0, c0, h, w));
   }
   out.gx = Plane::Zero(cal.rows, cal.cols);
   out.gy = Plane::Zero(cal.rows, cal.cols);
