@@ -74,8 +74,8 @@ py::tuple target_state(const reg::Target<double>& t) {
                         c.grid_spacing_factor, c.field_cell, c.field_margin, c.field_max_cells);
 }
 
-/// The target of target_state(): the normals as they were, not estimated again.
-reg::Target<double> target_from(const py::tuple& a) {
+/// The configuration in a target_state() tuple.
+reg::TargetConfig target_config(const py::tuple& a) {
   if (a.size() != 7) throw py::value_error("Target: damaged pickled state");
   reg::TargetConfig c;
   c.normal_neighbors = a[2].cast<int>();
@@ -83,22 +83,20 @@ reg::Target<double> target_from(const py::tuple& a) {
   c.field_cell = a[4].cast<double>();
   c.field_margin = a[5].cast<double>();
   c.field_max_cells = a[6].cast<std::size_t>();
-  Cloud cloud = cloud_from(a[0].cast<ArrayD>(), a[1].cast<ArrayD>(), "pickled points");
-  py::gil_scoped_release release;
-  return reg::Target<double>(std::move(cloud), c);
+  return c;
 }
 
-/// Pickling (version 1) for a class whose state is one tuple.
-template <class T, class Get, class Set>
-void pickle_state(py::class_<T>& cls, const char* name, Get get, Set set) {
-  cls.def(py::pickle([get](const T& t) { return py::make_tuple(1, get(t)); },
-                     [set, name](const py::tuple& s) {
-                       if (s.size() != 2 || s[0].cast<int>() != 1) {
-                         throw py::value_error(std::string(name) +
-                                               ": not a pickled state of version 1");
-                       }
-                       return set(s[1].cast<py::tuple>());
-                     }));
+/// The points and normals of a target_state() tuple, as a cloud.
+Cloud target_cloud(const py::tuple& a) {
+  return cloud_from(a[0].cast<ArrayD>(), a[1].cast<ArrayD>(), "pickled points");
+}
+
+/// The target of target_state(): the normals as they were, not estimated again.
+reg::Target<double> target_from(const py::tuple& a) {
+  const reg::TargetConfig c = target_config(a);
+  Cloud cloud = target_cloud(a);
+  py::gil_scoped_release release;
+  return reg::Target<double>(std::move(cloud), c);
 }
 
 }  // namespace
@@ -110,7 +108,7 @@ void bind_registration(py::module_& root) {
 A model prepared for registration: points [m], unit normals (given, or estimated by PCA over
 `normal_neighbors` points and oriented away from the centroid), a nearest-neighbour grid and,
 with field_cell > 0 [m], a closest-point field for approximate correspondences.)doc");
-  pickle_state(target_cls, "Target", target_state, target_from);
+  pickle_with<false>(target_cls, "Target", target_state, target_from);
   target_cls
       .def(py::init([](const ArrayD& points, const std::optional<ArrayD>& normals,
                        int normal_neighbors, bool recompute_normals, double grid_spacing_factor,
@@ -306,7 +304,7 @@ kernel's default, 1 mm; 3 mm for Tukey). Distances in metres, angles in radians.
 Named object models; recognize() ranks them by how well each explains a cloud (multi-start
 point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its starts out over
 `threads` threads (0: every core); the answer does not depend on the number.)doc");
-  pickle_state(
+  pickle_with<false>(
       library_cls, "ObjectLibrary",
       [](const reg::ObjectLibrary<double>& lib) {
         const auto lock = read_lock(&lib);
@@ -345,15 +343,7 @@ point-to-plane ICP, then a truncated RMS score [m]). One recognition shares its 
         for (const auto& item : a[1].cast<py::list>()) {
           const auto model = item.cast<py::tuple>();
           const auto t = model[1].cast<py::tuple>();
-          if (t.size() != 7) throw py::value_error("ObjectLibrary: damaged pickled model");
-          reg::TargetConfig tc;
-          tc.normal_neighbors = t[2].cast<int>();
-          tc.grid_spacing_factor = t[3].cast<double>();
-          tc.field_cell = t[4].cast<double>();
-          tc.field_margin = t[5].cast<double>();
-          tc.field_max_cells = t[6].cast<std::size_t>();
-          lib.add(model[0].cast<std::string>(),
-                  cloud_from(t[0].cast<ArrayD>(), t[1].cast<ArrayD>(), "pickled model"), tc);
+          lib.add(model[0].cast<std::string>(), target_cloud(t), target_config(t));
         }
         return lib;
       });
