@@ -263,18 +263,20 @@ TEST_CASE("optical: the running maximum of the marker search equals the brute-fo
           "[optical]") {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> g, h, out;
   for (int t = 0; t < 500; ++t) {
     const int n = 1 + int(rng() % 40), reach = 1 + int(rng() % 8);
     std::vector<double> x(static_cast<std::size_t>(n));
     for (double& v : x) v = u(rng);
-    to::detail::running_max(x, reach, g, h, out);
+    // One row: the running maximum along it.
+    to::Plane row(1, n);
+    for (int i = 0; i < n; ++i) row(0, i) = x[static_cast<std::size_t>(i)];
+    const to::Plane out = to::detail::running_max_2d(row, reach);
     for (int i = 0; i < n; ++i) {
       double m = -1;
       for (int k = std::max(0, i - reach); k <= std::min(n - 1, i + reach); ++k) {
         m = std::max(m, x[static_cast<std::size_t>(k)]);
       }
-      REQUIRE(out[static_cast<std::size_t>(i)] == m);
+      REQUIRE(out(0, i) == m);
     }
   }
 }

@@ -60,23 +60,6 @@ void van_herk(int n, int reach, Get x, G g, H h, Out out, Max max, Copy copy) {
 }
 
 // The 1-D running maximum of x (see van_herk) into out; g and h are workspace.
-inline void running_max(const std::vector<double>& x, int reach, std::vector<double>& g,
-                        std::vector<double>& h, std::vector<double>& out) {
-  const auto n = static_cast<int>(x.size());
-  g.resize(x.size());
-  h.resize(x.size());
-  out.resize(x.size());
-  const auto at = [](std::vector<double>& v) {
-    return [&v](int i) -> double& { return v[static_cast<std::size_t>(i)]; };
-  };
-  van_herk(
-      n, reach, [&](int i) { return x[static_cast<std::size_t>(i)]; }, at(g), at(h), at(out),
-      [](double& to, double a, double b) { to = std::max(a, b); },
-      [](double& to, double a) { to = a; });
-}
-
-// The running maximum over (2 reach + 1)^2 squares (clipped at the borders) of a plane: along
-// each row, then along the columns a whole row at a time.
 // The mask grown by one pixel to its 4-neighbours (rows and columns shifted, whole rows at a
 // time, which Eigen vectorises).
 inline image::Mask dilate4(const image::Mask& m) {
