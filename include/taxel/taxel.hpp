@@ -11,4 +11,5 @@
 #include "taxel/optical.hpp"
 #include "taxel/registration.hpp"
 #include "taxel/sensor.hpp"
+#include "taxel/shape.hpp"
 #include "taxel/sim.hpp"

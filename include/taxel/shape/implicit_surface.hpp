@@ -1,0 +1,406 @@
+// SPDX-License-Identifier: MIT
+// A Gaussian-process implicit surface (Williams and Fitzgibbon, "Gaussian process implicit
+// surfaces", Gaussian Processes in Practice workshop, 2006; Dragiev, Toussaint and Gienger,
+// ICRA 2011): a field f over space, negative inside the object, zero on its surface, positive
+// outside, about the signed distance near the surface. Each surface point p with outward normal
+// n and variance s^2 along n gives three observations: f(p) = 0, f(p + d n) = d and
+// f(p - d n) = -d (d the normal offset), each with noise variance s^2.
+//
+// The prior mean is the signed distance to a sphere, m(x) = |x - c| - r (Martens, Poffet, Yang
+// and Hausman, "Geometric priors for Gaussian process implicit surfaces", IEEE RA-L 2017), so
+// that the field is a closed surface far from every touch; the process models f - m.
+//
+// Local experts (after Lee, Zhang and Lee, "Online continuous mapping using Gaussian process
+// implicit surfaces", ICRA 2019): expert (i, j, k) sits at (i, j, k) L, L the expert size, and
+// holds the observations of the points in the cube of side 2 L around it, in an exact
+// Gaussian process of its own. A point therefore lives in the 8 experts around it, and adding
+// it extends their Cholesky factors by one row per observation (O(n^2) each, no refit). A query
+// at x blends the 8 experts around it with trilinear weights w_e (a partition of unity that
+// vanishes at the far side of each expert's cube, so the field is continuous):
+//   mean = m(x) + sum w_e mu_e(x),
+//   variance = sum w_e (var_e(x) + mu_e(x)^2) - (sum w_e mu_e(x))^2   (the mixture's),
+// an expert with no observations predicting the prior (mu = 0, var = k(0)). When every point
+// lies in one cell of side L, all 8 experts hold them all and the blend is the exact process.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "taxel/core/types.hpp"
+#include "taxel/shape/gaussian_process.hpp"
+#include "taxel/shape/grid.hpp"
+#include "taxel/shape/kernels.hpp"
+
+namespace taxel::shape {
+
+/// Settings of an ImplicitSurface. Lengths in metres.
+struct SurfaceConfig {
+  /// L: spacing of the experts; each holds the points within L of it along every axis, so its
+  /// size grows with L^2 of touched surface. Finite and > 0.
+  double expert_size = 0.01;
+  /// d: the off-surface observations' distance along the normal; 0 leaves them out (the
+  /// normals then go unused). Finite and >= 0.
+  double normal_offset = 0.003;
+  /// Lower bound of each observation's noise standard deviation. Finite and > 0.
+  double min_sigma = 0.2e-3;
+  /// c: centre of the prior sphere.
+  Vec3d prior_centre = Vec3d::Zero();
+  /// r: radius of the prior sphere; 0 makes the prior the distance to c. Finite and >= 0.
+  double prior_radius = 0.0;
+
+  /// Throws std::invalid_argument naming the first setting out of range.
+  void validate() const {
+    const auto bad = [](const char* name, double v, const char* range) {
+      throw std::invalid_argument(std::string("SurfaceConfig::") + name + " must be " + range +
+                                  ", got " + std::to_string(v));
+    };
+    if (!(expert_size > 0.0) || !std::isfinite(expert_size))
+      bad("expert_size", expert_size, "finite and > 0 [m]");
+    if (!(normal_offset >= 0.0) || !std::isfinite(normal_offset))
+      bad("normal_offset", normal_offset, "finite and >= 0 [m]");
+    if (!(min_sigma > 0.0) || !std::isfinite(min_sigma))
+      bad("min_sigma", min_sigma, "finite and > 0 [m]");
+    if (!prior_centre.allFinite())
+      throw std::invalid_argument("SurfaceConfig::prior_centre must be finite");
+    if (!(prior_radius >= 0.0) || !std::isfinite(prior_radius))
+      bad("prior_radius", prior_radius, "finite and >= 0 [m]");
+  }
+};
+
+/// Integer coordinates of an expert or a cell.
+using CellIndex = std::array<int, 3>;
+
+/// A Gaussian-process implicit surface over local experts (see the file comment). Points are
+/// added, moved and removed one at a time. Copyable; not thread-safe for writes, concurrent
+/// const queries are safe.
+template <Kernel K = Matern32>
+class ImplicitSurface {
+ public:
+  /// One expert: its process and, per observation, the point it came from (id * 4 + kind,
+  /// kind 0 on the surface, 1 outside, 2 inside).
+  struct Expert {
+    CellIndex cell{};                   ///< its position is cell * expert_size
+    GaussianProcess<K> process;         ///< the process of its observations, minus the prior mean
+    std::vector<std::uint64_t> owners;  ///< per observation: point id * 4 + kind
+  };
+  /// A stored surface point.
+  struct Point {
+    Vec3d position = Vec3d::Zero();  ///< [m]
+    Vec3d normal = Vec3d::UnitZ();   ///< outward unit normal
+    double variance = 0.0;           ///< along the normal [m^2], before the floor
+    bool alive = false;              ///< false once erased
+  };
+
+  /// Throws std::invalid_argument for an invalid configuration.
+  explicit ImplicitSurface(const SurfaceConfig& config = {}, K kernel = K{})
+      : config_(config), kernel_(std::move(kernel)) {
+    config_.validate();
+  }
+
+  /// The settings.
+  [[nodiscard]] const SurfaceConfig& config() const noexcept { return config_; }
+  /// The kernel.
+  [[nodiscard]] const K& kernel() const noexcept { return kernel_; }
+  /// Number of stored points.
+  [[nodiscard]] std::size_t size() const noexcept { return alive_; }
+  /// Number of experts.
+  [[nodiscard]] std::size_t expert_count() const noexcept { return experts_.size(); }
+  /// Every expert.
+  [[nodiscard]] const std::vector<Expert>& experts() const noexcept { return experts_; }
+  /// Point `id` (ids count up from 0 and are never reused).
+  [[nodiscard]] const Point& point(std::size_t id) const { return points_.at(id); }
+  /// Ids handed out so far.
+  [[nodiscard]] std::size_t id_count() const noexcept { return points_.size(); }
+
+  /// Adds surface point `p` with outward normal `normal` (any length > 0) and variance
+  /// `variance` [m^2] along it; returns its id, or nothing (and the surface unchanged) for a
+  /// non-finite input, a zero normal or a negative variance.
+  std::optional<std::size_t> insert(const Vec3d& p, const Vec3d& normal, double variance) {
+    if (!valid(p, normal, variance)) return std::nullopt;
+    const std::size_t id = points_.size();
+    points_.push_back({p, normal.normalized(), variance, true});
+    ++alive_;
+    attach(id);
+    return id;
+  }
+
+  /// Moves point `id` to `p` with `normal` and `variance` (a fused point that moved). Returns
+  /// false, and changes nothing, for an invalid input. Throws std::out_of_range for an id never
+  /// handed out or erased.
+  bool update(std::size_t id, const Vec3d& p, const Vec3d& normal, double variance) {
+    check_id(id, "update");
+    if (!valid(p, normal, variance)) return false;
+    detach(id);
+    points_[id] = {p, normal.normalized(), variance, true};
+    attach(id);
+    return true;
+  }
+
+  /// Removes point `id`. Throws std::out_of_range for an id never handed out or erased.
+  void erase(std::size_t id) {
+    check_id(id, "erase");
+    detach(id);
+    points_[id].alive = false;
+    --alive_;
+  }
+
+  /// Replaces the prior sphere (every expert's targets change: O(n^2) per expert). Throws
+  /// std::invalid_argument for a non-finite centre or a negative or non-finite radius.
+  void set_prior(const Vec3d& centre, double radius) {
+    SurfaceConfig c = config_;
+    c.prior_centre = centre;
+    c.prior_radius = radius;
+    c.validate();
+    config_ = c;
+    for (Expert& e : experts_) {
+      Eigen::VectorXd y(static_cast<Eigen::Index>(e.owners.size()));
+      for (std::size_t i = 0; i < e.owners.size(); ++i) {
+        const auto [x, v] = observation(e.owners[i]);
+        y(static_cast<Eigen::Index>(i)) = v - prior(x);
+      }
+      e.process.set_values(y);
+    }
+  }
+
+  /// The prior mean m(x) = |x - c| - r.
+  [[nodiscard]] double prior(const Vec3d& x) const {
+    return (x - config_.prior_centre).norm() - config_.prior_radius;
+  }
+
+  /// Posterior mean of the field at `x` (8 experts, O(n) each).
+  [[nodiscard]] double mean(const Vec3d& x) const {
+    double out = prior(x);
+    for_each_corner(x, [&](const Expert* e, double w, const Vec3d&) {
+      if (e != nullptr) out += w * e->process.mean(x);
+    });
+    return out;
+  }
+
+  /// Posterior mean of the field at `x` and its gradient (8 experts, O(n) each).
+  [[nodiscard]] double mean(const Vec3d& x, Vec3d& gradient) const {
+    double out = 0.0;
+    gradient.setZero();
+    for_each_corner(x, [&](const Expert* e, double w, const Vec3d& dw) {
+      if (e == nullptr) return;
+      Vec3d g;
+      const double mu = e->process.mean(x, g);
+      out += w * mu;
+      gradient += w * g + mu * dw;
+    });
+    const Vec3d d = x - config_.prior_centre;
+    const double dn = d.norm();
+    if (dn > 0.0) gradient += d / dn;
+    return out + dn - config_.prior_radius;
+  }
+
+  /// Posterior mean, variance and the mean's gradient at `x` (8 experts, O(n^2) each).
+  [[nodiscard]] FieldPrediction predict(const Vec3d& x) const {
+    FieldPrediction out;
+    double second = 0.0;
+    for_each_corner(x, [&](const Expert* e, double w, const Vec3d& dw) {
+      FieldPrediction p;
+      p.variance = kernel_.variance();
+      if (e != nullptr) p = e->process.predict(x);
+      out.mean += w * p.mean;
+      second += w * (p.variance + p.mean * p.mean);
+      out.gradient += w * p.gradient + p.mean * dw;
+    });
+    out.variance = std::max(0.0, second - out.mean * out.mean);
+    const Vec3d d = x - config_.prior_centre;
+    const double dn = d.norm();
+    out.mean += dn - config_.prior_radius;
+    if (dn > 0.0) out.gradient += d / dn;
+    return out;
+  }
+
+  /// The posterior mean at every node of `grid` (entry order of Grid). Throws
+  /// std::invalid_argument for an invalid grid.
+  [[nodiscard]] std::vector<double> sample(const Grid& grid) const {
+    grid.validate();
+    Eigen::Matrix3Xd nodes(3, static_cast<Eigen::Index>(grid.size()));
+    for (int k = 0; k < grid.nodes[2]; ++k) {
+      for (int j = 0; j < grid.nodes[1]; ++j) {
+        for (int i = 0; i < grid.nodes[0]; ++i)
+          nodes.col(static_cast<Eigen::Index>(grid.index(i, j, k))) = grid.node(i, j, k);
+      }
+    }
+    std::vector<double> out(grid.size());
+    evaluate(nodes, out.data(), nullptr);
+    return out;
+  }
+
+  /// Posterior means, and variances when `variance` is not null, at the columns of `points`:
+  /// the points are grouped by cell, and each of a cell's 8 experts predicts the whole group
+  /// through one kernel matrix (and one multi-column triangular solve for the variances).
+  void evaluate(const Eigen::Ref<const Eigen::Matrix3Xd>& points, double* mean,
+                double* variance) const {
+    const Eigen::Index total = points.cols();
+    std::vector<std::pair<std::uint64_t, Eigen::Index>> order(static_cast<std::size_t>(total));
+    for (Eigen::Index q = 0; q < total; ++q)
+      order[static_cast<std::size_t>(q)] = {key(cell_of(points.col(q))), q};
+    std::sort(order.begin(), order.end());
+    Eigen::Matrix3Xd group;
+    Eigen::VectorXd mu, var, acc, second;
+    for (std::size_t first = 0; first < order.size();) {
+      std::size_t last = first;
+      while (last < order.size() && order[last].first == order[first].first) ++last;
+      const auto m = static_cast<Eigen::Index>(last - first);
+      group.resize(3, m);
+      for (Eigen::Index q = 0; q < m; ++q)
+        group.col(q) = points.col(order[first + static_cast<std::size_t>(q)].second);
+      const CellIndex base = cell_of(group.col(0));
+      acc.setZero(m);
+      second.setZero(m);
+      mu.resize(m);
+      for (int c = 0; c < 8; ++c) {
+        const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+        const Expert* e = find({base[0] + dx, base[1] + dy, base[2] + dz});
+        if ((e == nullptr || e->process.size() == 0) && variance == nullptr) continue;
+        if (e != nullptr) {
+          e->process.predict(group, mu, variance != nullptr ? &var : nullptr);
+        } else {
+          mu.setZero();
+          var.setConstant(m, kernel_.variance());
+        }
+        for (Eigen::Index q = 0; q < m; ++q) {
+          const Vec3d t = group.col(q) / config_.expert_size - Vec3d(base[0], base[1], base[2]);
+          const double w = (dx ? t[0] : 1 - t[0]) * (dy ? t[1] : 1 - t[1]) * (dz ? t[2] : 1 - t[2]);
+          acc(q) += w * mu(q);
+          if (variance != nullptr) second(q) += w * (var(q) + mu(q) * mu(q));
+        }
+      }
+      for (Eigen::Index q = 0; q < m; ++q) {
+        const auto at = static_cast<std::size_t>(order[first + static_cast<std::size_t>(q)].second);
+        mean[at] = acc(q) + prior(group.col(q));
+        if (variance != nullptr) variance[at] = std::max(0.0, second(q) - acc(q) * acc(q));
+      }
+      first = last;
+    }
+  }
+
+  /// A key unique to each cell within 2^20 cells of the origin.
+  [[nodiscard]] static std::uint64_t cell_key(const CellIndex& c) noexcept {
+    const auto part = [](int v) { return std::uint64_t(std::uint32_t(v) & 0x1FFFFFu); };
+    return part(c[0]) | (part(c[1]) << 21) | (part(c[2]) << 42);
+  }
+
+  /// The expert at `cell`, or nullptr.
+  [[nodiscard]] const Expert* find(const CellIndex& cell) const {
+    const auto it = lookup_.find(key(cell));
+    return it == lookup_.end() ? nullptr : &experts_[it->second];
+  }
+  /// The cell of side L holding `x` (its experts are this cell and the 7 above it).
+  [[nodiscard]] CellIndex cell_of(const Vec3d& x) const {
+    const Vec3d u = x / config_.expert_size;
+    return {static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])),
+            static_cast<int>(std::floor(u[2]))};
+  }
+  /// The expert nearest `x`.
+  [[nodiscard]] CellIndex nearest_expert(const Vec3d& x) const {
+    const Vec3d u = x / config_.expert_size;
+    return {static_cast<int>(std::lround(u[0])), static_cast<int>(std::lround(u[1])),
+            static_cast<int>(std::lround(u[2]))};
+  }
+  /// The most observations any expert holds.
+  [[nodiscard]] std::size_t largest_expert() const noexcept {
+    std::size_t n = 0;
+    for (const Expert& e : experts_) n = std::max(n, e.process.size());
+    return n;
+  }
+  /// Position and value of an observation, from its owner code (id * 4 + kind).
+  [[nodiscard]] std::pair<Vec3d, double> observation(std::uint64_t owner) const {
+    const Point& p = points_[owner / 4];
+    const double d = config_.normal_offset;
+    switch (owner % 4) {
+      case 1:
+        return {p.position + d * p.normal, d};
+      case 2:
+        return {p.position - d * p.normal, -d};
+      default:
+        return {p.position, 0.0};
+    }
+  }
+  /// Noise variance of point `id`'s observations: its variance, floored at min_sigma^2.
+  [[nodiscard]] double noise(std::size_t id) const {
+    return std::max(points_.at(id).variance, config_.min_sigma * config_.min_sigma);
+  }
+
+  /// Calls f(expert or nullptr, weight, gradient of the weight) for the 8 experts around `x`.
+  template <class F>
+  void for_each_corner(const Vec3d& x, F&& f) const {
+    const double L = config_.expert_size;
+    const CellIndex base = cell_of(x);
+    const Vec3d t = x / L - Vec3d(base[0], base[1], base[2]);
+    for (int c = 0; c < 8; ++c) {
+      const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+      const double wx = dx ? t[0] : 1 - t[0], wy = dy ? t[1] : 1 - t[1], wz = dz ? t[2] : 1 - t[2];
+      const Vec3d dw((dx ? 1.0 : -1.0) * wy * wz / L, (dy ? 1.0 : -1.0) * wx * wz / L,
+                     (dz ? 1.0 : -1.0) * wx * wy / L);
+      f(find({base[0] + dx, base[1] + dy, base[2] + dz}), wx * wy * wz, dw);
+    }
+  }
+
+ private:
+  static std::uint64_t key(const CellIndex& c) noexcept { return cell_key(c); }
+  bool valid(const Vec3d& p, const Vec3d& normal, double variance) const {
+    return p.allFinite() && normal.allFinite() && normal.norm() > 1e-12 && variance >= 0.0 &&
+           std::isfinite(variance) &&
+           // Beyond 2^20 cells the expert keys would wrap.
+           (p / config_.expert_size).cwiseAbs().maxCoeff() < double(1 << 20) - 2;
+  }
+  void check_id(std::size_t id, const char* what) const {
+    if (id >= points_.size() || !points_[id].alive) {
+      throw std::out_of_range(std::string("ImplicitSurface::") + what + ": no point " +
+                              std::to_string(id));
+    }
+  }
+  Expert& expert(const CellIndex& cell) {
+    const auto [it, added] = lookup_.try_emplace(key(cell), experts_.size());
+    if (added) experts_.push_back({cell, GaussianProcess<K>(kernel_), {}});
+    return experts_[it->second];
+  }
+  int kinds() const { return config_.normal_offset > 0.0 ? 3 : 1; }
+  void attach(std::size_t id) {
+    const CellIndex base = cell_of(points_[id].position);
+    const double nv = noise(id);
+    for (int c = 0; c < 8; ++c) {
+      Expert& e = expert({base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + ((c >> 2) & 1)});
+      for (int kind = 0; kind < kinds(); ++kind) {
+        const std::uint64_t owner = std::uint64_t(id) * 4 + std::uint64_t(kind);
+        const auto [x, v] = observation(owner);
+        if (e.process.add(x, v - prior(x), nv)) e.owners.push_back(owner);
+      }
+    }
+  }
+  void detach(std::size_t id) {
+    const CellIndex base = cell_of(points_[id].position);
+    for (int c = 0; c < 8; ++c) {
+      const auto it = lookup_.find(
+          key({base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + ((c >> 2) & 1)}));
+      if (it == lookup_.end()) continue;
+      Expert& e = experts_[it->second];
+      for (std::size_t i = e.owners.size(); i-- > 0;) {
+        if (e.owners[i] / 4 != id) continue;
+        e.process.remove(i);
+        e.owners.erase(e.owners.begin() + static_cast<std::ptrdiff_t>(i));
+      }
+    }
+  }
+
+  SurfaceConfig config_;
+  K kernel_;
+  std::vector<Point> points_;
+  std::size_t alive_ = 0;
+  std::vector<Expert> experts_;
+  std::unordered_map<std::uint64_t, std::size_t> lookup_;
+};
+
+}  // namespace taxel::shape

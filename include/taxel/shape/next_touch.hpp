@@ -1,0 +1,207 @@
+// SPDX-License-Identifier: MIT
+// Where to touch next: each candidate touch is an approach ray the robot can follow. Its
+// contact is predicted on the current estimate (the first crossing of the posterior mean's
+// zero level along the ray), and it is scored by the expected reduction of the surface's
+// uncertainty, as in GPAtlasRRT (Rosales, Suarez and Shemonski, IJHR 2018) touches go where
+// the surface is least certain. A touch observes the field (value 0) at its contact and at
+// `patch_points` points on a circle of `patch_radius` around it in the predicted tangent plane,
+// each with noise sigma^2. With the expert e nearest the contact, whose posterior covariance is
+// C(a, b) = k(|a - b|) - v(a)' v(b) (GaussianProcess::whiten), those observations O lower the
+// variance at a target point q by
+//   gain(q) = c' S^-1 c,   c = C(q, O),   S = C(O, O) + sigma^2 I,
+// which does not depend on the values observed, so it is exact before touching. The score is
+// the sum of gain(q) over the targets q (e.g. the estimated surface's vertices) within `radius`
+// of the contact; 0 when the ray predicts no contact.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "taxel/core/types.hpp"
+#include "taxel/index/kdtree.hpp"
+#include "taxel/shape/grid.hpp"
+#include "taxel/shape/implicit_surface.hpp"
+
+namespace taxel::shape {
+
+/// A touch the robot can make: along the ray origin + t direction, 0 <= t <= max_distance.
+struct TouchCandidate {
+  Vec3d origin = Vec3d::Zero();       ///< [m]
+  Vec3d direction = -Vec3d::UnitZ();  ///< any length > 0 (normalised on use)
+  double max_distance = 0.5;          ///< [m]
+};
+
+/// A candidate's predicted outcome.
+struct TouchPrediction {
+  bool contact = false;          ///< whether the ray meets the estimated surface
+  Vec3d point = Vec3d::Zero();   ///< the predicted contact [m]
+  Vec3d normal = Vec3d::Zero();  ///< the estimate's outward normal there
+  double gain = 0.0;             ///< expected reduction of summed variance [m^2]
+};
+
+/// Settings of score_touches. Lengths in metres.
+struct ScoringConfig {
+  double noise_sigma = 0.3e-3;  ///< sigma: noise of each predicted observation, > 0
+  double radius = 0.015;        ///< targets farther from the contact do not count, > 0
+  int patch_points = 4;         ///< points on the circle around the contact, in [0, 64]
+  double patch_radius = 3e-3;   ///< the circle's radius, >= 0
+
+  /// Throws std::invalid_argument naming the first setting out of range.
+  void validate() const {
+    if (!(noise_sigma > 0.0) || !std::isfinite(noise_sigma))
+      throw std::invalid_argument("ScoringConfig::noise_sigma must be finite and > 0 [m]");
+    if (!(radius > 0.0) || !std::isfinite(radius))
+      throw std::invalid_argument("ScoringConfig::radius must be finite and > 0 [m]");
+    if (patch_points < 0 || patch_points > 64)
+      throw std::invalid_argument("ScoringConfig::patch_points must be in [0, 64], got " +
+                                  std::to_string(patch_points));
+    if (!(patch_radius >= 0.0) || !std::isfinite(patch_radius))
+      throw std::invalid_argument("ScoringConfig::patch_radius must be finite and >= 0 [m]");
+  }
+};
+
+/// The observation points of a touch at `point` with outward normal `normal` (see the file
+/// comment): the contact first, then the circle.
+template <class = void>
+[[nodiscard]] std::vector<Vec3d> touch_patch(const Vec3d& point, const Vec3d& normal,
+                                             const ScoringConfig& config) {
+  std::vector<Vec3d> out{point};
+  const Vec3d n = normal.norm() > 0.0 ? Vec3d(normal.normalized()) : Vec3d::UnitZ();
+  const Vec3d u = n.unitOrthogonal(), v = n.cross(u);
+  for (int i = 0; i < config.patch_points; ++i) {
+    const double a = 2.0 * std::numbers::pi * i / config.patch_points;
+    out.push_back(point + config.patch_radius * (std::cos(a) * u + std::sin(a) * v));
+  }
+  return out;
+}
+
+/// Expected reduction of the variance at each of `targets` when the observations at `at`
+/// (noise variance `noise`) join process `gp` (the file comment's gain(q), exact).
+template <Kernel K>
+[[nodiscard]] Eigen::VectorXd variance_reduction(const GaussianProcess<K>& gp,
+                                                 const std::vector<Vec3d>& at, double noise,
+                                                 const Eigen::Matrix3Xd& targets) {
+  const auto m = static_cast<Eigen::Index>(at.size());
+  Eigen::Matrix3Xd o(3, m);
+  for (Eigen::Index i = 0; i < m; ++i) o.col(i) = at[static_cast<std::size_t>(i)];
+  Eigen::MatrixXd wo(static_cast<Eigen::Index>(gp.size()), m);
+  for (Eigen::Index i = 0; i < m; ++i) wo.col(i) = gp.whiten(o.col(i));
+  Eigen::MatrixXd s(m, m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index j = 0; j < m; ++j) s(i, j) = gp.kernel()((o.col(i) - o.col(j)).norm());
+  if (gp.size() > 0) s -= wo.transpose() * wo;
+  s.diagonal().array() += noise;
+  const Eigen::LLT<Eigen::MatrixXd> llt(s);
+  Eigen::VectorXd out(targets.cols());
+  for (Eigen::Index q = 0; q < targets.cols(); ++q) {
+    Eigen::VectorXd c(m);
+    for (Eigen::Index i = 0; i < m; ++i) c(i) = gp.kernel()((targets.col(q) - o.col(i)).norm());
+    if (gp.size() > 0) c -= wo.transpose() * gp.whiten(targets.col(q));
+    out(q) = c.dot(llt.solve(c));
+  }
+  return out;
+}
+
+/// Predicts and scores every candidate touch (see the file comment) on `surface`, whose
+/// posterior mean is `field` on `grid` (ImplicitSurface::sample). `targets` are the points
+/// whose uncertainty counts. Throws std::invalid_argument for a bad configuration, a field
+/// that does not fit the grid or a non-finite target.
+template <Kernel K>
+[[nodiscard]] std::vector<TouchPrediction> score_touches(
+    const ImplicitSurface<K>& surface, const Grid& grid, const std::vector<double>& field,
+    const std::vector<Vec3d>& targets, const std::vector<TouchCandidate>& candidates,
+    const ScoringConfig& config = {}) {
+  config.validate();
+  grid.validate();
+  if (field.size() != grid.size())
+    throw std::invalid_argument("score_touches: the field does not fit the grid");
+  std::vector<TouchPrediction> out(candidates.size());
+  if (targets.empty()) return out;
+  const index::KdTree<double> tree(targets);
+  const double noise = config.noise_sigma * config.noise_sigma;
+  // Per expert: the whitened targets it needs, computed once (a multi-column solve).
+  struct Cache {
+    Eigen::MatrixXd whitened;  // n x ids
+    std::unordered_map<std::uint32_t, Eigen::Index> column;
+  };
+  std::unordered_map<std::uint64_t, Cache> caches;
+  const double L = surface.config().expert_size;
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const TouchCandidate& cand = candidates[c];
+    if (!cand.origin.allFinite() || !cand.direction.allFinite() || !(cand.direction.norm() > 0.0))
+      continue;
+    const Vec3d dir = cand.direction.normalized();
+    const std::optional<Vec3d> hit =
+        first_crossing(grid, field, cand.origin, dir, cand.max_distance);
+    if (!hit) continue;
+    TouchPrediction& p = out[c];
+    p.contact = true;
+    p.point = *hit;
+    Vec3d g;
+    (void)surface.mean(*hit, g);
+    p.normal = g.norm() > 0.0 ? Vec3d(g.normalized()) : Vec3d(-dir);
+    const std::vector<Vec3d> patch = touch_patch(p.point, p.normal, config);
+    const auto near = tree.within(p.point, config.radius);
+    if (near.empty()) continue;
+    const CellIndex cell = surface.nearest_expert(p.point);
+    const auto* e = surface.find(cell);
+    if (e == nullptr || e->process.size() == 0) {
+      // No observations: the prior, whose variance reduction needs no whitening.
+      GaussianProcess<K> prior(surface.kernel());
+      Eigen::Matrix3Xd q(3, static_cast<Eigen::Index>(near.size()));
+      for (std::size_t i = 0; i < near.size(); ++i)
+        q.col(static_cast<Eigen::Index>(i)) = targets[near[i].id];
+      p.gain = variance_reduction(prior, patch, noise, q).sum();
+      continue;
+    }
+    const GaussianProcess<K>& gp = e->process;
+    auto [it, fresh] = caches.try_emplace(ImplicitSurface<K>::cell_key(cell));
+    Cache& cache = it->second;
+    if (fresh) {
+      // Every target a contact in this expert's half-cell can reach.
+      const Vec3d centre = L * Vec3d(cell[0], cell[1], cell[2]);
+      const auto reach = tree.within(centre, std::sqrt(3.0) * 0.5 * L + config.radius);
+      Eigen::Matrix3Xd q(3, static_cast<Eigen::Index>(reach.size()));
+      for (std::size_t i = 0; i < reach.size(); ++i) {
+        cache.column[reach[i].id] = static_cast<Eigen::Index>(i);
+        q.col(static_cast<Eigen::Index>(i)) = targets[reach[i].id];
+      }
+      cache.whitened = gp.cross_covariances(q);
+      gp.solve_lower(cache.whitened);
+    }
+    // gain(q) = c' S^-1 c with c = k(q, O) - W_O' w_q.
+    const auto m = static_cast<Eigen::Index>(patch.size());
+    Eigen::MatrixXd wo(static_cast<Eigen::Index>(gp.size()), m);
+    for (Eigen::Index i = 0; i < m; ++i) wo.col(i) = gp.whiten(patch[static_cast<std::size_t>(i)]);
+    Eigen::MatrixXd s(m, m);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      for (Eigen::Index j = 0; j < m; ++j) {
+        s(i, j) = surface.kernel()(
+            (patch[static_cast<std::size_t>(i)] - patch[static_cast<std::size_t>(j)]).norm());
+      }
+    }
+    s.noalias() -= wo.transpose() * wo;
+    s.diagonal().array() += noise;
+    const Eigen::LLT<Eigen::MatrixXd> llt(s);
+    Eigen::VectorXd cq(m);
+    for (const auto& nb : near) {
+      const auto col = cache.column.find(static_cast<std::uint32_t>(nb.id));
+      if (col == cache.column.end()) continue;  // cannot happen: the reach covers the radius
+      const Vec3d& q = targets[nb.id];
+      for (Eigen::Index i = 0; i < m; ++i)
+        cq(i) = surface.kernel()((q - patch[static_cast<std::size_t>(i)]).norm());
+      cq.noalias() -= wo.transpose() * cache.whitened.col(col->second);
+      p.gain += cq.dot(llt.solve(cq));
+    }
+  }
+  return out;
+}
+
+}  // namespace taxel::shape
