@@ -3,6 +3,7 @@
 // Gaussian-process implicit surface over local experts), its mesh, and where to touch next.
 #pragma once
 
+#include "taxel/shape/explorer.hpp"
 #include "taxel/shape/gaussian_process.hpp"
 #include "taxel/shape/grid.hpp"
 #include "taxel/shape/implicit_surface.hpp"

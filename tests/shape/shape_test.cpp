@@ -500,8 +500,11 @@ TEST_CASE("score_touches: the gain equals a brute-force refit", "[shape][touch]"
   for (const Vec3d& xy : {Vec3d(0.009, 0.012, 0), Vec3d(0.009, 0.002, 0), Vec3d(0.003, 0.006, 0)})
     cands.push_back({xy + Vec3d(0, 0, 0.05), Vec3d(0, 0, -1), 0.2});
   cands.push_back({Vec3d(0.5, 0.5, 0.5), Vec3d(1, 0, 0), 0.2});  // misses the grid
-  const sh::ScoringConfig cfg{
-      .noise_sigma = 0.4e-3, .radius = 0.008, .patch_points = 3, .patch_radius = 0.002};
+  const sh::ScoringConfig cfg{.noise_sigma = 0.4e-3,
+                              .radius = 0.008,
+                              .patch_points = 3,
+                              .patch_radius = 0.002,
+                              .target_spacing = 0.0};
   const auto scores = sh::score_touches(surface, grid, field, targets, cands, cfg);
   REQUIRE(scores.size() == 4);
   CHECK_FALSE(scores[3].contact);

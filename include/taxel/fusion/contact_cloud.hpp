@@ -246,6 +246,8 @@ class ContactCloud {
   [[nodiscard]] const I& index() const noexcept { return index_; }
   /// The configuration in use.
   [[nodiscard]] const Config& config() const noexcept { return config_; }
+  /// The fusion policy (e.g. for Surfel's `normal(state(id))`).
+  [[nodiscard]] const F& policy() const noexcept { return policy_; }
 
   /// Which points count as confident surface points (`to_point_cloud`, `confident`).
   struct PointFilter {

@@ -32,6 +32,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "taxel/core/types.hpp"
@@ -160,6 +161,7 @@ class ImplicitSurface {
     c.prior_radius = radius;
     c.validate();
     config_ = c;
+    all_changed_ = true;
     for (Expert& e : experts_) {
       Eigen::VectorXd y(static_cast<Eigen::Index>(e.owners.size()));
       for (std::size_t i = 0; i < e.owners.size(); ++i) {
@@ -292,6 +294,61 @@ class ImplicitSurface {
     return part(c[0]) | (part(c[1]) << 21) | (part(c[2]) << 42);
   }
 
+  /// The experts whose observations changed since the last clear_changed() (keys of
+  /// cell_key), unless every_expert_changed().
+  [[nodiscard]] const std::vector<std::uint64_t>& changed_experts() const noexcept {
+    return changed_;
+  }
+  /// True when every expert changed (the prior was replaced) since the last clear_changed().
+  [[nodiscard]] bool every_expert_changed() const noexcept { return all_changed_; }
+  /// Forgets which experts changed.
+  void clear_changed() noexcept {
+    changed_.clear();
+    all_changed_ = false;
+  }
+
+  /// The posterior mean at the nodes of `grid` in cells next to an expert that changed since
+  /// the last clear_changed() (all nodes when every expert changed), written into `field`, the
+  /// grid's samples before those changes. Throws std::invalid_argument for a field that does
+  /// not fit the grid.
+  void resample(const Grid& grid, std::vector<double>& field) const {
+    grid.validate();
+    if (field.size() != grid.size())
+      throw std::invalid_argument("ImplicitSurface::resample: the field does not fit the grid");
+    if (all_changed_) {
+      field = sample(grid);
+      return;
+    }
+    if (changed_.empty()) return;
+    std::unordered_set<std::uint64_t> cells;
+    for (const std::uint64_t k : changed_) {
+      const CellIndex c = experts_[lookup_.at(k)].cell;
+      for (int i = 0; i < 8; ++i)
+        cells.insert(key({c[0] - (i & 1), c[1] - ((i >> 1) & 1), c[2] - ((i >> 2) & 1)}));
+    }
+    std::vector<std::size_t> entries;
+    for (int k = 0; k < grid.nodes[2]; ++k) {
+      for (int j = 0; j < grid.nodes[1]; ++j) {
+        for (int i = 0; i < grid.nodes[0]; ++i) {
+          if (cells.count(key(cell_of(grid.node(i, j, k)))) != 0)
+            entries.push_back(grid.index(i, j, k));
+        }
+      }
+    }
+    Eigen::Matrix3Xd nodes(3, static_cast<Eigen::Index>(entries.size()));
+    for (std::size_t e = 0; e < entries.size(); ++e) {
+      const std::size_t at = entries[e];
+      const int i = static_cast<int>(at % std::size_t(grid.nodes[0]));
+      const int j = static_cast<int>(at / std::size_t(grid.nodes[0]) % std::size_t(grid.nodes[1]));
+      const int k =
+          static_cast<int>(at / (std::size_t(grid.nodes[0]) * std::size_t(grid.nodes[1])));
+      nodes.col(static_cast<Eigen::Index>(e)) = grid.node(i, j, k);
+    }
+    std::vector<double> values(entries.size());
+    evaluate(nodes, values.data(), nullptr);
+    for (std::size_t e = 0; e < entries.size(); ++e) field[entries[e]] = values[e];
+  }
+
   /// The expert at `cell`, or nullptr.
   [[nodiscard]] const Expert* find(const CellIndex& cell) const {
     const auto it = lookup_.find(key(cell));
@@ -365,7 +422,12 @@ class ImplicitSurface {
   Expert& expert(const CellIndex& cell) {
     const auto [it, added] = lookup_.try_emplace(key(cell), experts_.size());
     if (added) experts_.push_back({cell, GaussianProcess<K>(kernel_), {}});
+    mark(it->first);
     return experts_[it->second];
+  }
+  void mark(std::uint64_t k) {
+    if (!all_changed_ && std::find(changed_.begin(), changed_.end(), k) == changed_.end())
+      changed_.push_back(k);
   }
   int kinds() const { return config_.normal_offset > 0.0 ? 3 : 1; }
   void attach(std::size_t id) {
@@ -387,6 +449,7 @@ class ImplicitSurface {
           key({base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + ((c >> 2) & 1)}));
       if (it == lookup_.end()) continue;
       Expert& e = experts_[it->second];
+      mark(it->first);
       for (std::size_t i = e.owners.size(); i-- > 0;) {
         if (e.owners[i] / 4 != id) continue;
         e.process.remove(i);
@@ -401,6 +464,8 @@ class ImplicitSurface {
   std::size_t alive_ = 0;
   std::vector<Expert> experts_;
   std::unordered_map<std::uint64_t, std::size_t> lookup_;
+  std::vector<std::uint64_t> changed_;
+  bool all_changed_ = true;
 };
 
 }  // namespace taxel::shape

@@ -19,9 +19,11 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "taxel/core/types.hpp"
@@ -49,9 +51,12 @@ struct TouchPrediction {
 /// Settings of score_touches. Lengths in metres.
 struct ScoringConfig {
   double noise_sigma = 0.3e-3;  ///< sigma: noise of each predicted observation, > 0
-  double radius = 0.015;        ///< targets farther from the contact do not count, > 0
+  double radius = 0.012;        ///< targets farther from the contact do not count, > 0
   int patch_points = 4;         ///< points on the circle around the contact, in [0, 64]
   double patch_radius = 3e-3;   ///< the circle's radius, >= 0
+  /// The targets are thinned to the first in each cube of this side (a mesh's vertices are
+  /// far denser than the variance changes); 0 keeps them all. Finite and >= 0.
+  double target_spacing = 4e-3;
 
   /// Throws std::invalid_argument naming the first setting out of range.
   void validate() const {
@@ -64,8 +69,39 @@ struct ScoringConfig {
                                   std::to_string(patch_points));
     if (!(patch_radius >= 0.0) || !std::isfinite(patch_radius))
       throw std::invalid_argument("ScoringConfig::patch_radius must be finite and >= 0 [m]");
+    if (!(target_spacing >= 0.0) || !std::isfinite(target_spacing))
+      throw std::invalid_argument("ScoringConfig::target_spacing must be finite and >= 0 [m]");
   }
 };
+
+/// `count` approach rays, each from a uniformly random point on the sphere of radius
+/// `standoff` around `centre` towards a uniformly random point of the ball of radius
+/// `aim_radius` around it, reaching 2 * standoff. Throws std::invalid_argument unless
+/// standoff > aim_radius >= 0 and count >= 0.
+template <class Rng>
+[[nodiscard]] std::vector<TouchCandidate> approach_rays(const Vec3d& centre, double standoff,
+                                                        double aim_radius, int count, Rng& rng) {
+  if (!centre.allFinite() || !(aim_radius >= 0.0) || !(standoff > aim_radius) ||
+      !std::isfinite(standoff) || count < 0) {
+    throw std::invalid_argument(
+        "approach_rays: needs a finite centre, standoff > aim_radius >= 0 and count >= 0");
+  }
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto unit = [&] {
+    Vec3d d(g(rng), g(rng), g(rng));
+    while (!(d.norm() > 1e-12)) d = Vec3d(g(rng), g(rng), g(rng));
+    return Vec3d(d.normalized());
+  };
+  std::vector<TouchCandidate> out;
+  out.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    const Vec3d from = centre + standoff * unit();
+    const Vec3d aim = centre + aim_radius * std::cbrt(u(rng)) * unit();
+    out.push_back({from, (aim - from).normalized(), 2.0 * standoff});
+  }
+  return out;
+}
 
 /// The observation points of a touch at `point` with outward normal `normal` (see the file
 /// comment): the contact first, then the circle.
@@ -110,19 +146,35 @@ template <Kernel K>
 }
 
 /// Predicts and scores every candidate touch (see the file comment) on `surface`, whose
-/// posterior mean is `field` on `grid` (ImplicitSurface::sample). `targets` are the points
-/// whose uncertainty counts. Throws std::invalid_argument for a bad configuration, a field
-/// that does not fit the grid or a non-finite target.
+/// posterior mean is `field` on `grid` (ImplicitSurface::sample). The targets, the points whose
+/// uncertainty counts, are `all_targets` thinned by config.target_spacing. Throws
+/// std::invalid_argument for a bad configuration, a field that does not fit the grid or a
+/// non-finite target.
 template <Kernel K>
 [[nodiscard]] std::vector<TouchPrediction> score_touches(
     const ImplicitSurface<K>& surface, const Grid& grid, const std::vector<double>& field,
-    const std::vector<Vec3d>& targets, const std::vector<TouchCandidate>& candidates,
+    const std::vector<Vec3d>& all_targets, const std::vector<TouchCandidate>& candidates,
     const ScoringConfig& config = {}) {
   config.validate();
   grid.validate();
   if (field.size() != grid.size())
     throw std::invalid_argument("score_touches: the field does not fit the grid");
   std::vector<TouchPrediction> out(candidates.size());
+  for (const Vec3d& t : all_targets) {
+    if (!t.allFinite()) throw std::invalid_argument("score_touches: a target is not finite");
+  }
+  std::vector<Vec3d> targets;
+  if (config.target_spacing > 0.0) {
+    std::unordered_set<std::uint64_t> seen;
+    for (const Vec3d& t : all_targets) {
+      const Vec3d u = t / config.target_spacing;
+      const CellIndex c{static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])),
+                        static_cast<int>(std::floor(u[2]))};
+      if (seen.insert(ImplicitSurface<K>::cell_key(c)).second) targets.push_back(t);
+    }
+  } else {
+    targets = all_targets;
+  }
   if (targets.empty()) return out;
   const index::KdTree<double> tree(targets);
   const double noise = config.noise_sigma * config.noise_sigma;

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -343,6 +344,56 @@ Exploration<Sh> explore_palpation(const Sh& shape, const ExplorationConfig& cfg,
     }
   }
   return ex;
+}
+
+/// One poke along a ray, as a robot probing an object: the pad approaches `shape` (world frame;
+/// wrap a placed shape in `Posed`) along origin + t direction (direction of any length > 0).
+/// Where the ray first meets the surface (sphere tracing on the exact signed distance), the
+/// pad, its face tangent there (a compliant wrist), presses in to cfg.indentation at
+/// `p.press_speed` and holds `p.hold_frames` frames; `p.touches` is not used. Appends the
+/// contacts of every frame to `out` (time from `start_time` at cfg.frame_rate) and returns the
+/// point where the ray met the surface, or nothing when it misses within `max_distance`.
+/// Throws std::invalid_argument for invalid parameters or a non-finite ray.
+template <Shape Sh, class Rng>
+std::optional<Vec3d> poke(const Sh& shape, const ExplorationConfig& cfg, const Vec3d& origin,
+                          const Vec3d& direction, double max_distance, Rng& rng,
+                          std::vector<Contact<double>>& out, const PalpationParams& p = {},
+                          double start_time = 0.0) {
+  cfg.validate();
+  if (!origin.allFinite() || !direction.allFinite() || !(direction.norm() > 0.0) ||
+      !(max_distance >= 0.0) || !std::isfinite(max_distance)) {
+    throw std::invalid_argument("poke: the ray must be finite with a direction of length > 0");
+  }
+  if (!(p.press_speed > 0) || !std::isfinite(p.press_speed) || p.hold_frames < 0 ||
+      p.hold_frames > 1000000) {
+    throw std::invalid_argument("PalpationParams: press_speed > 0 and hold_frames in [0, 1e6]");
+  }
+  const Vec3d d = direction.normalized();
+  double t = 0.0;
+  std::optional<Vec3d> hit;
+  for (int it = 0; it < 10000 && t <= max_distance; ++it) {
+    const double s = shape.signed_distance(Vec3d(origin + t * d));
+    if (s < 1e-9) {
+      hit = origin + t * d;
+      break;
+    }
+    t += s;
+  }
+  if (!hit) return std::nullopt;
+  const Vec3d n = shape.normal(*hit);
+  const Vec3d y = detail::random_unit(rng);
+  sensor::ContactExtractor extractor(cfg.sensor, cfg.contacts);
+  const double step = p.press_speed / cfg.frame_rate;
+  const int pressing =
+      detail::frames_to_press(cfg.indentation, p.press_speed, cfg.frame_rate, "PalpationParams") +
+      2;
+  for (int f = 0; f < pressing + p.hold_frames; ++f) {
+    const double s = std::min(double(f - 2) * step, cfg.indentation);
+    const PadReading r =
+        read_pad(shape, cfg.sensor, detail::pad_pose(-n, y, *hit - s * n), rng, 0, cfg.footprint);
+    extractor.extract(r.counts, r.believed_pose, start_time + double(f) / cfg.frame_rate, out);
+  }
+  return hit;
 }
 
 }  // namespace taxel::sim

@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: MIT
+// Explorer: the loop of active touch in one object. Contacts are fused into a ContactCloud;
+// every fused point that a batch of contacts added or moved is put into (or moved in) the
+// implicit surface, with the fusion policy's normal and its variance along that normal; the
+// surface's posterior mean is sampled on a grid over the workspace, meshed with each vertex's
+// uncertainty, and candidate touches are scored on it.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "taxel/core/contact.hpp"
+#include "taxel/fusion/contact_cloud.hpp"
+#include "taxel/fusion/surfel.hpp"
+#include "taxel/index/voxel_hash.hpp"
+#include "taxel/shape/grid.hpp"
+#include "taxel/shape/implicit_surface.hpp"
+#include "taxel/shape/kernels.hpp"
+#include "taxel/shape/next_touch.hpp"
+#include "taxel/shape/surface_mesh.hpp"
+
+namespace taxel::shape {
+
+/// Settings of an Explorer. Lengths in metres.
+struct ExplorerConfig {
+  Vec3d workspace_min = Vec3d::Constant(-0.06);  ///< corner of the box the object lies in
+  Vec3d workspace_max = Vec3d::Constant(0.06);   ///< opposite corner
+  double grid_spacing = 2e-3;                    ///< of the sampled field and its mesh, > 0
+  SurfaceConfig surface{};                       ///< the implicit surface
+  MaternConfig kernel{};                         ///< its kernel
+  ScoringConfig scoring{};                       ///< how candidate touches are scored
+  /// Re-fit the prior sphere's radius to the points' mean distance from its centre after
+  /// every batch (the centre stays surface.prior_centre); off keeps surface.prior_radius.
+  bool fit_prior_radius = true;
+};
+
+/// Fused cloud, implicit surface, sampled field, mesh and touch scoring for one object (see
+/// the file comment). `K` is the surface's kernel, `Cloud` a ContactCloud whose policy
+/// estimates normals (Surfel by default; a policy without them leaves the prior's normal).
+template <Kernel K = Matern32,
+          class Cloud = fusion::ContactCloud<fusion::Surfel<double>, index::VoxelHash<double>>>
+class Explorer {
+ public:
+  /// Throws std::invalid_argument for an invalid configuration.
+  explicit Explorer(const ExplorerConfig& config = {}, const typename Cloud::Config& fusion = {})
+      : config_(checked(config)),
+        cloud_(fusion),
+        surface_(config_.surface, K(config_.kernel)),
+        grid_(Grid::covering(config_.workspace_min, config_.workspace_max, config_.grid_spacing)) {}
+
+  /// Fuses `contacts` and brings the surface up to date. Returns how many fused points were
+  /// added or moved.
+  std::size_t add_contacts(std::span<const Contact<double>> contacts) {
+    std::vector<index::PointId> changed;
+    for (const auto& c : contacts) {
+      const fusion::InsertResult r = cloud_.insert(c);
+      if (r.status != fusion::InsertStatus::rejected) changed.push_back(r.id);
+    }
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    for (const index::PointId id : changed) sync(id);
+    if (config_.fit_prior_radius && surface_.size() > 0) {
+      double sum = 0.0;
+      for (const auto& s : of_cloud_) {
+        if (s) sum += (surface_.point(*s).position - config_.surface.prior_centre).norm();
+      }
+      // Refitted when it moves by more than 5 %: a new prior changes every expert.
+      const double r = sum / double(surface_.size()), now = surface_.config().prior_radius;
+      if (!(std::abs(r - now) <= 0.05 * now)) surface_.set_prior(config_.surface.prior_centre, r);
+    }
+    if (!changed.empty()) {
+      fresh_ = false;
+      mesh_.reset();
+    }
+    return changed.size();
+  }
+
+  /// The fused contacts.
+  [[nodiscard]] const Cloud& cloud() const noexcept { return cloud_; }
+  /// The implicit surface.
+  [[nodiscard]] const ImplicitSurface<K>& surface() const noexcept { return surface_; }
+  /// The grid over the workspace.
+  [[nodiscard]] const Grid& grid() const noexcept { return grid_; }
+  /// The settings.
+  [[nodiscard]] const ExplorerConfig& config() const noexcept { return config_; }
+
+  /// The posterior mean sampled on the grid (brought up to date after a change, in the cells
+  /// next to the experts that changed).
+  const std::vector<double>& field() {
+    if (!fresh_) {
+      if (field_.size() != grid_.size()) {
+        field_ = surface_.sample(grid_);
+      } else {
+        surface_.resample(grid_, field_);
+      }
+      surface_.clear_changed();
+      fresh_ = true;
+    }
+    return field_;
+  }
+  /// The estimated surface with per-vertex standard deviations (computed once per change).
+  const SurfaceMesh& estimate() {
+    if (!mesh_) mesh_ = extract_surface(surface_, grid_, field());
+    return *mesh_;
+  }
+  /// Predicts and scores `candidates` on the current estimate, its vertices the targets.
+  std::vector<TouchPrediction> score(const std::vector<TouchCandidate>& candidates) {
+    return score_touches(surface_, grid_, field(), estimate().mesh.vertices, candidates,
+                         config_.scoring);
+  }
+
+ private:
+  static const ExplorerConfig& checked(const ExplorerConfig& c) {
+    c.surface.validate();
+    c.scoring.validate();
+    (void)K(c.kernel);
+    (void)Grid::covering(c.workspace_min, c.workspace_max, c.grid_spacing);
+    return c;
+  }
+  void sync(index::PointId id) {
+    const Vec3d p = cloud_.mean(id);
+    Vec3d n = Vec3d::Zero();
+    if constexpr (requires { cloud_.policy().normal(cloud_.state(id)); }) {
+      n = cloud_.policy().normal(cloud_.state(id));
+    }
+    if (!(n.norm() > 0.5)) {
+      n = p - config_.surface.prior_centre;
+      if (!(n.norm() > 0.0)) n = Vec3d::UnitZ();
+    }
+    n.normalize();
+    const double var = n.dot(cloud_.covariance(id) * n);
+    if (id >= of_cloud_.size()) of_cloud_.resize(std::size_t{id} + 1);
+    auto& slot = of_cloud_[id];
+    if (slot) {
+      (void)surface_.update(*slot, p, n, var);
+    } else {
+      slot = surface_.insert(p, n, var);
+    }
+  }
+
+  ExplorerConfig config_;
+  Cloud cloud_;
+  ImplicitSurface<K> surface_;
+  Grid grid_;
+  std::vector<std::optional<std::size_t>> of_cloud_;  // cloud id -> surface id
+  std::vector<double> field_;
+  bool fresh_ = false;
+  std::optional<SurfaceMesh> mesh_;
+};
+
+}  // namespace taxel::shape
