@@ -13,7 +13,9 @@
 #include <stdexcept>
 #include <string>
 #include <taxel/index/kdtree.hpp>
+#include <taxel/registration/object_library.hpp>
 #include <taxel/shape/explorer.hpp>
+#include <taxel/shape/recognition.hpp>
 #include <taxel/sim/exploration.hpp>
 #include <taxel/sim/sampling.hpp>
 #include <taxel/sim/sensor.hpp>
@@ -39,6 +41,9 @@ struct Settings {
   taxel::sim::ExplorationConfig sensing{};  ///< the pad and its noise (object_pose is set here)
   taxel::sim::PalpationParams press{.touches = 1, .press_speed = 0.05, .hold_frames = 5};
   taxel::shape::ExplorerConfig explorer{};  ///< workspace and prior are set from the object
+  /// Models to recognise the object among (none: no recognition).
+  const taxel::registration::ObjectLibrary<double>* library = nullptr;
+  taxel::shape::BeliefConfig belief{};  ///< how recognitions become probabilities
 };
 
 /// The state after one touch.
@@ -50,6 +55,8 @@ struct TouchRecord {
   double surface_rms = 0.0;  ///< symmetric RMS distance estimate <-> truth [m]
   double coverage = 0.0;     ///< share of the true surface within coverage_radius of a point
   double mean_std = 0.0;     ///< area-weighted mean posterior standard deviation [m]
+  std::string top1;          ///< most probable model (with a library; empty before 6 points)
+  double probability = 0.0;  ///< its probability
   taxel::shape::SurfaceMesh estimate;  ///< the estimate after the touch (kept when asked)
 };
 
@@ -146,12 +153,27 @@ std::vector<TouchRecord> explore(const Sh& shape, Settings s, OnTouch&& on_touch
   std::vector<TouchRecord> out;
   std::vector<taxel::Contact<double>> contacts, all;
   std::mt19937_64 metric_rng(s.seed + 11);
+  std::vector<tsh::Hypothesis> belief;
   double time = 0.0;
   for (int k = 1; k <= s.touches; ++k) {
     std::vector<tsh::TouchCandidate> rays =
         tsh::approach_rays(Vec3d::Zero(), reach + 0.03, 0.5 * reach, s.candidates, rng);
     tsh::TouchCandidate pick = rays.front();
-    if (s.policy == Policy::active) {
+    bool picked = false;
+    if (s.policy == Policy::active && s.library != nullptr && belief.size() >= 2) {
+      // Recognition first: the touch that best tells the likely models apart.
+      const std::vector<double> gain =
+          tsh::score_recognition_touches(*s.library, belief, rays, s.belief);
+      double best = 1e-6;  // a touch that tells nothing apart leaves the choice to the surface
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (gain[i] > best) {
+          best = gain[i];
+          pick = rays[i];
+          picked = true;
+        }
+      }
+    }
+    if (s.policy == Policy::active && !picked) {
       const std::vector<tsh::TouchPrediction> scores = explorer.score(rays);
       double best = -1.0;
       for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -190,6 +212,14 @@ std::vector<TouchRecord> explore(const Sh& shape, Settings s, OnTouch&& on_touch
       for (const Vec3d& p : truth.points)
         covered += tree.nearest_within(p, s.coverage_radius).has_value();
       r.coverage = double(covered) / double(truth.points.size());
+    }
+    if (s.library != nullptr && r.points >= 6) {
+      const taxel::PointCloud<double> cloud = explorer.cloud().to_point_cloud();
+      belief = tsh::hypotheses(s.library->recognize(cloud), cloud.size(), s.belief);
+      if (!belief.empty()) {
+        r.top1 = belief.front().name;
+        r.probability = belief.front().probability;
+      }
     }
     on_touch(r);
     out.push_back(std::move(r));

@@ -10,4 +10,5 @@
 #include "taxel/shape/kernels.hpp"
 #include "taxel/shape/marching.hpp"
 #include "taxel/shape/next_touch.hpp"
+#include "taxel/shape/recognition.hpp"
 #include "taxel/shape/surface_mesh.hpp"

@@ -231,7 +231,7 @@ TEST_CASE("ImplicitSurface: a touched plane away from the prior", "[shape][surfa
   CHECK(far.variance == Approx(surface.kernel().variance()));
 }
 
-TEST_CASE("ImplicitSurface: experts equal the exact process when one cell holds every point",
+TEST_CASE("ImplicitSurface: experts equal the exact process when they hold every point",
           "[shape][surface]") {
   const double L = 0.02;
   sh::SurfaceConfig cfg{.expert_size = L,
@@ -242,7 +242,10 @@ TEST_CASE("ImplicitSurface: experts equal the exact process when one cell holds 
   sh::ImplicitSurface surface(cfg);
   sh::GaussianProcess exact(surface.kernel());
   std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(0.001, L - 0.001);
+  // Points in the lower half of cell 0 along every axis: experts -1 and 0 on each axis hold
+  // them all, and answer every query within (1 - blend) L of the origin.
+  std::uniform_real_distribution<double> u(0.001, 0.5 * L - 0.001);
+  std::uniform_real_distribution<double> uq(-0.85 * L, 0.85 * L);
   std::normal_distribution<double> g;
   for (int i = 0; i < 12; ++i) {
     const Vec3d p(u(rng), u(rng), u(rng));
@@ -257,8 +260,7 @@ TEST_CASE("ImplicitSurface: experts equal the exact process when one cell holds 
   }
   CHECK(surface.expert_count() == 8);
   for (int i = 0; i < 30; ++i) {
-    // Inside the cell every expert is the exact process; outside, some are the prior.
-    const Vec3d x(u(rng), u(rng), u(rng));
+    const Vec3d x(uq(rng), uq(rng), uq(rng));
     const sh::FieldPrediction p = surface.predict(x), e = exact.predict(x);
     CHECK(p.mean == Approx(e.mean + surface.prior(x)).margin(1e-12));
     CHECK(p.variance == Approx(e.variance).margin(1e-14));
@@ -315,7 +317,7 @@ TEST_CASE("ImplicitSurface: the blended field is continuous and its gradient exa
   for (int i = 0; i < 40; ++i) {
     const Vec3d x = random_point(rng, 0.025);
     const sh::FieldPrediction p = surface.predict(x);
-    Vec3d grad;
+    Vec3d grad = Vec3d::Zero();
     CHECK(surface.mean(x, grad) == Approx(p.mean).margin(1e-15));
     CHECK((grad - p.gradient).norm() < 1e-12);
     for (int a = 0; a < 3; ++a) {

@@ -39,7 +39,9 @@ class GaussianProcess {
   /// The covariance kernel.
   [[nodiscard]] const K& kernel() const noexcept { return kernel_; }
   /// Observation positions (3 x size()).
-  [[nodiscard]] auto positions() const { return x_.leftCols(static_cast<Eigen::Index>(n_)); }
+  [[nodiscard]] auto positions() const {
+    return x_.topRows(static_cast<Eigen::Index>(n_)).transpose();
+  }
   /// Observed values.
   [[nodiscard]] auto values() const { return y_.head(static_cast<Eigen::Index>(n_)); }
   /// Noise variances of the observations.
@@ -68,7 +70,7 @@ class GaussianProcess {
     const double d = std::sqrt(d2);
     L_.row(n).head(n) = l.transpose();
     L_(n, n) = d;
-    x_.col(n) = x;
+    x_.row(n) = x.transpose();
     y_(n) = y;
     noise_(n) = noise_variance;
     z_(n) = (y - l.dot(z_.head(n))) / d;
@@ -101,7 +103,7 @@ class GaussianProcess {
       for (Eigen::Index a = std::max(b, k); a + 1 < n; ++a) L_(a, b) = L_(old(a), old(b));
     }
     for (Eigen::Index a = k; a + 1 < n; ++a) {
-      x_.col(a) = x_.col(a + 1);
+      x_.row(a) = x_.row(a + 1);
       y_(a) = y_(a + 1);
       noise_(a) = noise_(a + 1);
     }
@@ -122,18 +124,13 @@ class GaussianProcess {
 
   /// Posterior mean at `x`. O(n).
   [[nodiscard]] double mean(const Vec3d& x) const {
-    if (n_ == 0) return 0.0;
-    return kernel_.values(distances(x)).matrix().dot(weights());
+    Vec3d unused = Vec3d::Zero();
+    return mean<false>(x, unused);
   }
 
   /// Posterior mean at `x` and its gradient. O(n).
   [[nodiscard]] double mean(const Vec3d& x, Vec3d& gradient) const {
-    gradient.setZero();
-    if (n_ == 0) return 0.0;
-    const Eigen::ArrayXd r = distances(x);
-    const Eigen::ArrayXd w = kernel_.slopes(r) * weights().array();
-    gradient = x * w.sum() - positions() * w.matrix();
-    return kernel_.values(r).matrix().dot(weights());
+    return mean<true>(x, gradient);
   }
 
   /// Posterior mean, variance and gradient at `x`. O(n^2) (a triangular solve).
@@ -199,13 +196,39 @@ class GaussianProcess {
   }
 
  private:
+  // The mean (and gradient) in blocks of at most 256 observations on the stack: no allocation,
+  // one exponential per observation.
+  template <bool Gradient>
+  double mean(const Vec3d& x, Vec3d& gradient) const {
+    using Block = Eigen::Array<double, Eigen::Dynamic, 1, 0, 256, 1>;
+    const auto n = static_cast<Eigen::Index>(n_);
+    double out = 0.0;
+    gradient.setZero();
+    Block dx, dy, dz, r, k, s;
+    for (Eigen::Index first = 0; first < n; first += 256) {
+      const Eigen::Index c = std::min<Eigen::Index>(256, n - first);
+      dx = x[0] - x_.col(0).segment(first, c).array();
+      dy = x[1] - x_.col(1).segment(first, c).array();
+      dz = x[2] - x_.col(2).segment(first, c).array();
+      r = (dx.square() + dy.square() + dz.square()).sqrt();
+      kernel_.evaluate(r, k, s);
+      const auto a = alpha_.segment(first, c).array();
+      out += (k * a).sum();
+      if constexpr (Gradient) {
+        // d k(|x - x_i|) / dx = k'(r) / r (x - x_i)
+        s *= a;
+        gradient += Vec3d((s * dx).sum(), (s * dy).sum(), (s * dz).sum());
+      }
+    }
+    return out;
+  }
   Eigen::ArrayXd distances(const Vec3d& x) const {
     return (positions().colwise() - x).colwise().norm().transpose().array();
   }
   void grow(std::size_t cap) {
     const auto c = static_cast<Eigen::Index>(cap);
     L_.conservativeResize(c, c);
-    x_.conservativeResize(3, c);
+    x_.conservativeResize(c, 3);
     y_.conservativeResize(c);
     noise_.conservativeResize(c);
     z_.conservativeResize(c);
@@ -232,7 +255,7 @@ class GaussianProcess {
   K kernel_;
   std::size_t n_ = 0, cap_ = 0;
   Eigen::MatrixXd L_;   // lower Cholesky factor of K in its top-left n x n corner
-  Eigen::Matrix3Xd x_;  // positions
+  Eigen::MatrixX3d x_;  // positions, one per row (each coordinate contiguous)
   Eigen::VectorXd y_, noise_, z_, alpha_;
 };
 

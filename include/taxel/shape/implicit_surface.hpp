@@ -11,16 +11,20 @@
 // that the field is a closed surface far from every touch; the process models f - m.
 //
 // Local experts (after Lee, Zhang and Lee, "Online continuous mapping using Gaussian process
-// implicit surfaces", ICRA 2019): expert (i, j, k) sits at (i, j, k) L, L the expert size, and
-// holds the observations of the points in the cube of side 2 L around it, in an exact
-// Gaussian process of its own. A point therefore lives in the 8 experts around it, and adding
-// it extends their Cholesky factors by one row per observation (O(n^2) each, no refit). A query
-// at x blends the 8 experts around it with trilinear weights w_e (a partition of unity that
-// vanishes at the far side of each expert's cube, so the field is continuous):
+// implicit surfaces", ICRA 2019): space is cut into cubic cells of side L, the expert size.
+// Expert c owns cell c and holds, in an exact Gaussian process of its own, the observations of
+// the points within L/2 of its cell (a cube of side 2 L), so a point lives in the 8 experts
+// around it, and adding it extends their Cholesky factors by one row per observation (O(n^2)
+// each, no refit). A query at x uses the expert of its cell alone, except within b L of a
+// cell face (b the blend width), where it blends the experts on both sides with smoothstep
+// weights, w(t) = t^2 (3 - 2 t) across the band, a product over the three axes: a partition
+// of unity with a continuous gradient. On average a query asks (1 + 2 b)^3 experts (1.7 at the
+// default b = 0.1):
 //   mean = m(x) + sum w_e mu_e(x),
 //   variance = sum w_e (var_e(x) + mu_e(x)^2) - (sum w_e mu_e(x))^2   (the mixture's),
 // an expert with no observations predicting the prior (mu = 0, var = k(0)). When every point
-// lies in one cell of side L, all 8 experts hold them all and the blend is the exact process.
+// lies within the lower half of one cell along each axis, the 8 experts around it hold them all
+// and every query near them is the exact process.
 #pragma once
 
 #include <Eigen/Core>
@@ -31,6 +35,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -50,6 +55,9 @@ struct SurfaceConfig {
   /// d: the off-surface observations' distance along the normal; 0 leaves them out (the
   /// normals then go unused). Finite and >= 0.
   double normal_offset = 0.003;
+  /// b: half-width of the band around a cell face where a query blends the experts on both
+  /// sides, as a fraction of expert_size. In (0, 0.5].
+  double blend = 0.1;
   /// Lower bound of each observation's noise standard deviation. Finite and > 0.
   double min_sigma = 0.2e-3;
   /// c: centre of the prior sphere.
@@ -65,6 +73,7 @@ struct SurfaceConfig {
     };
     if (!(expert_size > 0.0) || !std::isfinite(expert_size))
       bad("expert_size", expert_size, "finite and > 0 [m]");
+    if (!(blend > 0.0) || !(blend <= 0.5)) bad("blend", blend, "in (0, 0.5]");
     if (!(normal_offset >= 0.0) || !std::isfinite(normal_offset))
       bad("normal_offset", normal_offset, "finite and >= 0 [m]");
     if (!(min_sigma > 0.0) || !std::isfinite(min_sigma))
@@ -88,7 +97,7 @@ class ImplicitSurface {
   /// One expert: its process and, per observation, the point it came from (id * 4 + kind,
   /// kind 0 on the surface, 1 outside, 2 inside).
   struct Expert {
-    CellIndex cell{};                   ///< its position is cell * expert_size
+    CellIndex cell{};                   ///< the cell it owns: [cell, cell + 1) * expert_size
     GaussianProcess<K> process;         ///< the process of its observations, minus the prior mean
     std::vector<std::uint64_t> owners;  ///< per observation: point id * 4 + kind
   };
@@ -177,22 +186,22 @@ class ImplicitSurface {
     return (x - config_.prior_centre).norm() - config_.prior_radius;
   }
 
-  /// Posterior mean of the field at `x` (8 experts, O(n) each).
+  /// Posterior mean of the field at `x` (1 to 8 experts, O(n) each).
   [[nodiscard]] double mean(const Vec3d& x) const {
     double out = prior(x);
-    for_each_corner(x, [&](const Expert* e, double w, const Vec3d&) {
+    for_each_expert(x, [&](const Expert* e, double w, const Vec3d&) {
       if (e != nullptr) out += w * e->process.mean(x);
     });
     return out;
   }
 
-  /// Posterior mean of the field at `x` and its gradient (8 experts, O(n) each).
+  /// Posterior mean of the field at `x` and its gradient (1 to 8 experts, O(n) each).
   [[nodiscard]] double mean(const Vec3d& x, Vec3d& gradient) const {
     double out = 0.0;
     gradient.setZero();
-    for_each_corner(x, [&](const Expert* e, double w, const Vec3d& dw) {
+    for_each_expert(x, [&](const Expert* e, double w, const Vec3d& dw) {
       if (e == nullptr) return;
-      Vec3d g;
+      Vec3d g = Vec3d::Zero();
       const double mu = e->process.mean(x, g);
       out += w * mu;
       gradient += w * g + mu * dw;
@@ -203,11 +212,11 @@ class ImplicitSurface {
     return out + dn - config_.prior_radius;
   }
 
-  /// Posterior mean, variance and the mean's gradient at `x` (8 experts, O(n^2) each).
+  /// Posterior mean, variance and the mean's gradient at `x` (1 to 8 experts, O(n^2) each).
   [[nodiscard]] FieldPrediction predict(const Vec3d& x) const {
     FieldPrediction out;
     double second = 0.0;
-    for_each_corner(x, [&](const Expert* e, double w, const Vec3d& dw) {
+    for_each_expert(x, [&](const Expert* e, double w, const Vec3d& dw) {
       FieldPrediction p;
       p.variance = kernel_.variance();
       if (e != nullptr) p = e->process.predict(x);
@@ -245,53 +254,61 @@ class ImplicitSurface {
   void evaluate(const Eigen::Ref<const Eigen::Matrix3Xd>& points, double* mean,
                 double* variance) const {
     const Eigen::Index total = points.cols();
+    // Grouped by cell; each of the 27 experts around a cell predicts, in one batch, the
+    // group's points that blend it.
     std::vector<std::pair<std::uint64_t, Eigen::Index>> order(static_cast<std::size_t>(total));
     for (Eigen::Index q = 0; q < total; ++q)
       order[static_cast<std::size_t>(q)] = {key(cell_of(points.col(q))), q};
     std::sort(order.begin(), order.end());
-    Eigen::Matrix3Xd group;
-    Eigen::VectorXd mu, var, acc, second;
+    Eigen::Matrix3Xd subset;
+    Eigen::VectorXd mu, var;
+    std::vector<double> acc, second, w;
+    std::vector<Eigen::Index> members;
     for (std::size_t first = 0; first < order.size();) {
       std::size_t last = first;
       while (last < order.size() && order[last].first == order[first].first) ++last;
-      const auto m = static_cast<Eigen::Index>(last - first);
-      group.resize(3, m);
-      for (Eigen::Index q = 0; q < m; ++q)
-        group.col(q) = points.col(order[first + static_cast<std::size_t>(q)].second);
-      const CellIndex base = cell_of(group.col(0));
-      acc.setZero(m);
-      second.setZero(m);
-      mu.resize(m);
-      for (int c = 0; c < 8; ++c) {
-        const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-        const Expert* e = find({base[0] + dx, base[1] + dy, base[2] + dz});
-        if ((e == nullptr || e->process.size() == 0) && variance == nullptr) continue;
-        if (e != nullptr) {
-          e->process.predict(group, mu, variance != nullptr ? &var : nullptr);
-        } else {
-          mu.setZero();
-          var.setConstant(m, kernel_.variance());
+      const std::size_t m = last - first;
+      acc.assign(m, 0.0);
+      second.assign(m, 0.0);
+      w.resize(m);
+      const CellIndex base = cell_of(points.col(order[first].second));
+      for (int o = 0; o < 27; ++o) {
+        const CellIndex c{base[0] + o % 3 - 1, base[1] + o / 3 % 3 - 1, base[2] + o / 9 - 1};
+        members.clear();
+        for (std::size_t q = 0; q < m; ++q) {
+          w[q] = weight(points.col(order[first + q].second), c);
+          if (w[q] > 0.0) members.push_back(static_cast<Eigen::Index>(q));
         }
-        for (Eigen::Index q = 0; q < m; ++q) {
-          const Vec3d t = group.col(q) / config_.expert_size - Vec3d(base[0], base[1], base[2]);
-          const double w = (dx ? t[0] : 1 - t[0]) * (dy ? t[1] : 1 - t[1]) * (dz ? t[2] : 1 - t[2]);
-          acc(q) += w * mu(q);
-          if (variance != nullptr) second(q) += w * (var(q) + mu(q) * mu(q));
+        if (members.empty()) continue;
+        const Expert* e = find(c);
+        const bool empty = e == nullptr || e->process.size() == 0;
+        if (empty && variance == nullptr) continue;
+        const auto k = static_cast<Eigen::Index>(members.size());
+        mu.resize(k);
+        if (empty) {
+          mu.setZero();
+          var.setConstant(k, kernel_.variance());
+        } else {
+          subset.resize(3, k);
+          for (Eigen::Index i = 0; i < k; ++i)
+            subset.col(i) = points.col(
+                order[first + static_cast<std::size_t>(members[static_cast<std::size_t>(i)])]
+                    .second);
+          e->process.predict(subset, mu, variance != nullptr ? &var : nullptr);
+        }
+        for (Eigen::Index i = 0; i < k; ++i) {
+          const auto q = static_cast<std::size_t>(members[static_cast<std::size_t>(i)]);
+          acc[q] += w[q] * mu(i);
+          if (variance != nullptr) second[q] += w[q] * (var(i) + mu(i) * mu(i));
         }
       }
-      for (Eigen::Index q = 0; q < m; ++q) {
-        const auto at = static_cast<std::size_t>(order[first + static_cast<std::size_t>(q)].second);
-        mean[at] = acc(q) + prior(group.col(q));
-        if (variance != nullptr) variance[at] = std::max(0.0, second(q) - acc(q) * acc(q));
+      for (std::size_t q = 0; q < m; ++q) {
+        const auto at = static_cast<std::size_t>(order[first + q].second);
+        mean[at] = acc[q] + prior(points.col(order[first + q].second));
+        if (variance != nullptr) variance[at] = std::max(0.0, second[q] - acc[q] * acc[q]);
       }
       first = last;
     }
-  }
-
-  /// A key unique to each cell within 2^20 cells of the origin.
-  [[nodiscard]] static std::uint64_t cell_key(const CellIndex& c) noexcept {
-    const auto part = [](int v) { return std::uint64_t(std::uint32_t(v) & 0x1FFFFFu); };
-    return part(c[0]) | (part(c[1]) << 21) | (part(c[2]) << 42);
   }
 
   /// The experts whose observations changed since the last clear_changed() (keys of
@@ -323,8 +340,8 @@ class ImplicitSurface {
     std::unordered_set<std::uint64_t> cells;
     for (const std::uint64_t k : changed_) {
       const CellIndex c = experts_[lookup_.at(k)].cell;
-      for (int i = 0; i < 8; ++i)
-        cells.insert(key({c[0] - (i & 1), c[1] - ((i >> 1) & 1), c[2] - ((i >> 2) & 1)}));
+      for (int i = 0; i < 27; ++i)
+        cells.insert(key({c[0] + i % 3 - 1, c[1] + i / 3 % 3 - 1, c[2] + i / 9 - 1}));
     }
     std::vector<std::size_t> entries;
     for (int k = 0; k < grid.nodes[2]; ++k) {
@@ -349,23 +366,25 @@ class ImplicitSurface {
     for (std::size_t e = 0; e < entries.size(); ++e) field[entries[e]] = values[e];
   }
 
+  /// A key unique to each cell within 2^20 cells of the origin.
+  [[nodiscard]] static std::uint64_t cell_key(const CellIndex& c) noexcept {
+    const auto part = [](int v) { return std::uint64_t(std::uint32_t(v) & 0x1FFFFFu); };
+    return part(c[0]) | (part(c[1]) << 21) | (part(c[2]) << 42);
+  }
+
   /// The expert at `cell`, or nullptr.
   [[nodiscard]] const Expert* find(const CellIndex& cell) const {
     const auto it = lookup_.find(key(cell));
     return it == lookup_.end() ? nullptr : &experts_[it->second];
   }
-  /// The cell of side L holding `x` (its experts are this cell and the 7 above it).
+  /// The cell of side L holding `x`; its expert answers queries at x away from the faces.
   [[nodiscard]] CellIndex cell_of(const Vec3d& x) const {
     const Vec3d u = x / config_.expert_size;
     return {static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])),
             static_cast<int>(std::floor(u[2]))};
   }
-  /// The expert nearest `x`.
-  [[nodiscard]] CellIndex nearest_expert(const Vec3d& x) const {
-    const Vec3d u = x / config_.expert_size;
-    return {static_cast<int>(std::lround(u[0])), static_cast<int>(std::lround(u[1])),
-            static_cast<int>(std::lround(u[2]))};
-  }
+  /// The expert whose cell holds `x` (the same as cell_of).
+  [[nodiscard]] CellIndex nearest_expert(const Vec3d& x) const { return cell_of(x); }
   /// The most observations any expert holds.
   [[nodiscard]] std::size_t largest_expert() const noexcept {
     std::size_t n = 0;
@@ -390,23 +409,85 @@ class ImplicitSurface {
     return std::max(points_.at(id).variance, config_.min_sigma * config_.min_sigma);
   }
 
-  /// Calls f(expert or nullptr, weight, gradient of the weight) for the 8 experts around `x`.
+  /// Calls f(expert or nullptr, weight, gradient of the weight, cell) for each expert a query
+  /// at `x` blends (1 to 8; see the file comment).
   template <class F>
-  void for_each_corner(const Vec3d& x, F&& f) const {
-    const double L = config_.expert_size;
-    const CellIndex base = cell_of(x);
-    const Vec3d t = x / L - Vec3d(base[0], base[1], base[2]);
-    for (int c = 0; c < 8; ++c) {
-      const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-      const double wx = dx ? t[0] : 1 - t[0], wy = dy ? t[1] : 1 - t[1], wz = dz ? t[2] : 1 - t[2];
-      const Vec3d dw((dx ? 1.0 : -1.0) * wy * wz / L, (dy ? 1.0 : -1.0) * wx * wz / L,
-                     (dz ? 1.0 : -1.0) * wx * wy / L);
-      f(find({base[0] + dx, base[1] + dy, base[2] + dz}), wx * wy * wz, dw);
+  void for_each_expert(const Vec3d& x, F&& f) const {
+    std::array<std::array<int, 2>, 3> cell{};
+    std::array<std::array<double, 2>, 3> w{}, dw{};
+    std::array<int, 3> count{};
+    for (int a = 0; a < 3; ++a) axis(x[a], cell[a], w[a], dw[a], count[a]);
+    for (int i = 0; i < count[0]; ++i) {
+      for (int j = 0; j < count[1]; ++j) {
+        for (int k = 0; k < count[2]; ++k) {
+          const CellIndex c{cell[0][i], cell[1][j], cell[2][k]};
+          const double wx = w[0][i], wy = w[1][j], wz = w[2][k];
+          const Vec3d g(dw[0][i] * wy * wz, wx * dw[1][j] * wz, wx * wy * dw[2][k]);
+          if constexpr (std::is_invocable_v<F, const Expert*, double, const Vec3d&,
+                                            const CellIndex&>) {
+            f(find(c), wx * wy * wz, g, c);
+          } else {
+            f(find(c), wx * wy * wz, g);
+          }
+        }
+      }
     }
+  }
+
+  /// The weight of the expert at `cell` in a query at `x` (0 when it takes no part).
+  [[nodiscard]] double weight(const Vec3d& x, const CellIndex& c) const {
+    double out = 1.0;
+    for (int a = 0; a < 3; ++a) {
+      std::array<int, 2> cells{};
+      std::array<double, 2> w{}, dw{};
+      int count = 0;
+      axis(x[a], cells, w, dw, count);
+      double wa = 0.0;
+      for (int i = 0; i < count; ++i)
+        wa += cells[static_cast<std::size_t>(i)] == c[static_cast<std::size_t>(a)]
+                  ? w[static_cast<std::size_t>(i)]
+                  : 0.0;
+      out *= wa;
+    }
+    return out;
   }
 
  private:
   static std::uint64_t key(const CellIndex& c) noexcept { return cell_key(c); }
+  // Along one axis at coordinate v: the cells a query blends (1 or 2), their smoothstep
+  // weights and the weights' derivatives.
+  void axis(double v, std::array<int, 2>& cells, std::array<double, 2>& w,
+            std::array<double, 2>& dw, int& count) const {
+    const double L = config_.expert_size, b = config_.blend;
+    const double u = v / L;
+    const double c = std::floor(u);
+    const double f = u - c;
+    const int ci = static_cast<int>(c);
+    const auto step = [&](double t, double& value, double& slope) {
+      value = t * t * (3.0 - 2.0 * t);
+      slope = 6.0 * t * (1.0 - t) / (2.0 * b * L);
+    };
+    if (f < b || f > 1.0 - b) {
+      const int lo = f < b ? ci - 1 : ci;
+      double hi_w = 0.0, hi_d = 0.0;
+      step(f < b ? (f + b) / (2.0 * b) : (f - 1.0 + b) / (2.0 * b), hi_w, hi_d);
+      cells = {lo, lo + 1};
+      w = {1.0 - hi_w, hi_w};
+      dw = {-hi_d, hi_d};
+      count = 2;
+    } else {
+      cells = {ci, ci};
+      w = {1.0, 0.0};
+      dw = {0.0, 0.0};
+      count = 1;
+    }
+  }
+  // The experts that hold a point at p: per axis the two whose cells lie within L/2.
+  CellIndex lower_holder(const Vec3d& p) const {
+    const Vec3d u = p / config_.expert_size + Vec3d::Constant(0.5);
+    return {static_cast<int>(std::floor(u[0])) - 1, static_cast<int>(std::floor(u[1])) - 1,
+            static_cast<int>(std::floor(u[2])) - 1};
+  }
   bool valid(const Vec3d& p, const Vec3d& normal, double variance) const {
     return p.allFinite() && normal.allFinite() && normal.norm() > 1e-12 && variance >= 0.0 &&
            std::isfinite(variance) &&
@@ -431,7 +512,7 @@ class ImplicitSurface {
   }
   int kinds() const { return config_.normal_offset > 0.0 ? 3 : 1; }
   void attach(std::size_t id) {
-    const CellIndex base = cell_of(points_[id].position);
+    const CellIndex base = lower_holder(points_[id].position);
     const double nv = noise(id);
     for (int c = 0; c < 8; ++c) {
       Expert& e = expert({base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + ((c >> 2) & 1)});
@@ -443,7 +524,7 @@ class ImplicitSurface {
     }
   }
   void detach(std::size_t id) {
-    const CellIndex base = cell_of(points_[id].position);
+    const CellIndex base = lower_holder(points_[id].position);
     for (int c = 0; c < 8; ++c) {
       const auto it = lookup_.find(
           key({base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + ((c >> 2) & 1)}));

@@ -19,12 +19,14 @@ namespace taxel::shape {
 /// A stationary isotropic covariance k(r): `operator()(r)` its value, `slope(r)` the derivative
 /// k'(r) / r (finite at r = 0, so that the gradient k'(r) (x - y) / r needs no division), both
 /// also for arrays of distances (`values`, `slopes`), and `variance()` = k(0).
+/// `evaluate(r, k, s)` writes both for an array of distances with one exponential each.
 template <class K>
-concept Kernel = requires(const K& k, double r, const Eigen::ArrayXd& rs) {
+concept Kernel = requires(const K& k, double r, const Eigen::ArrayXd& rs, Eigen::ArrayXd& out) {
   { k(r) } -> std::convertible_to<double>;
   { k.slope(r) } -> std::convertible_to<double>;
   { k.values(rs) } -> std::convertible_to<Eigen::ArrayXd>;
   { k.slopes(rs) } -> std::convertible_to<Eigen::ArrayXd>;
+  k.evaluate(rs, out, out);
   { k.variance() } -> std::convertible_to<double>;
 };
 
@@ -75,6 +77,13 @@ struct Matern32 {
   [[nodiscard]] Eigen::ArrayXd slopes(const Eigen::ArrayXd& r) const {
     return -s2_ * a_ * a_ * (-a_ * r).exp();
   }
+  /// k(r) into `k` and k'(r) / r into `slope`, for each distance (one exponential each).
+  template <class R, class V, class S>
+  void evaluate(const R& r, V& k, S& slope) const {
+    slope = (-a_ * r).exp();
+    k = s2_ * (1.0 + a_ * r) * slope;
+    slope *= -s2_ * a_ * a_;
+  }
   /// k(0) = s^2.
   [[nodiscard]] double variance() const noexcept { return s2_; }
   /// The settings.
@@ -115,6 +124,13 @@ struct Matern52 {
   [[nodiscard]] Eigen::ArrayXd slopes(const Eigen::ArrayXd& r) const {
     const Eigen::ArrayXd a = a_ * r;
     return -s2_ * a_ * a_ / 3.0 * (1.0 + a) * (-a).exp();
+  }
+  /// k(r) into `k` and k'(r) / r into `slope`, for each distance (one exponential each).
+  template <class R, class V, class S>
+  void evaluate(const R& r, V& k, S& slope) const {
+    slope = (-a_ * r).exp();
+    k = s2_ * (1.0 + a_ * r + (a_ * a_ / 3.0) * r.square()) * slope;
+    slope *= -s2_ * a_ * a_ / 3.0 * (1.0 + a_ * r);
   }
   /// k(0) = s^2.
   [[nodiscard]] double variance() const noexcept { return s2_; }

@@ -196,7 +196,7 @@ template <Kernel K>
     TouchPrediction& p = out[c];
     p.contact = true;
     p.point = *hit;
-    Vec3d g;
+    Vec3d g = Vec3d::Zero();
     (void)surface.mean(*hit, g);
     p.normal = g.norm() > 0.0 ? Vec3d(g.normalized()) : Vec3d(-dir);
     const std::vector<Vec3d> patch = touch_patch(p.point, p.normal, config);
@@ -217,8 +217,8 @@ template <Kernel K>
     auto [it, fresh] = caches.try_emplace(ImplicitSurface<K>::cell_key(cell));
     Cache& cache = it->second;
     if (fresh) {
-      // Every target a contact in this expert's half-cell can reach.
-      const Vec3d centre = L * Vec3d(cell[0], cell[1], cell[2]);
+      // Every target a contact in this expert's cell can reach.
+      const Vec3d centre = L * (Vec3d(cell[0], cell[1], cell[2]) + Vec3d::Constant(0.5));
       const auto reach = tree.within(centre, std::sqrt(3.0) * 0.5 * L + config.radius);
       Eigen::Matrix3Xd q(3, static_cast<Eigen::Index>(reach.size()));
       for (std::size_t i = 0; i < reach.size(); ++i) {

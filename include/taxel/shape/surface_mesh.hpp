@@ -60,7 +60,7 @@ template <Kernel K>
   out.normals.resize(out.mesh.vertices.size());
   for (std::size_t i = 0; i < out.sigma.size(); ++i) {
     out.sigma[i] = std::sqrt(out.sigma[i]);
-    Vec3d g;
+    Vec3d g = Vec3d::Zero();
     (void)surface.mean(out.mesh.vertices[i], g);
     out.normals[i] = g.norm() > 0.0 ? Vec3d(g.normalized()) : Vec3d::UnitZ();
   }
