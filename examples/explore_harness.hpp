@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -149,6 +150,12 @@ std::vector<TouchRecord> explore(const Sh& shape, Settings s, OnTouch&& on_touch
   s.explorer.grid_spacing = s.grid_spacing;
   s.explorer.surface.prior_centre = Vec3d::Zero();
   s.explorer.surface.prior_radius = 0.5 * reach;
+  if (const char* v = std::getenv("TX_RADIUS")) s.explorer.scoring.radius = std::atof(v);
+  if (const char* v = std::getenv("TX_PATCH")) s.explorer.scoring.patch_points = std::atoi(v);
+  if (const char* v = std::getenv("TX_PATCH_R")) s.explorer.scoring.patch_radius = std::atof(v);
+  if (const char* v = std::getenv("TX_CAND")) s.candidates = std::atoi(v);
+  if (const char* v = std::getenv("TX_L")) s.explorer.kernel.length_scale = std::atof(v);
+  if (const char* v = std::getenv("TX_E")) s.explorer.surface.expert_size = std::atof(v);
   tsh::Explorer<> explorer(s.explorer);
   std::vector<TouchRecord> out;
   std::vector<taxel::Contact<double>> contacts, all;
@@ -194,6 +201,14 @@ std::vector<TouchRecord> explore(const Sh& shape, Settings s, OnTouch&& on_touch
                               contacts, s.press, time);
     time += 1.0;
     explorer.add_contacts(contacts);
+    // The approach was free up to the first contact along the ray (2 mm short of it), or all
+    // the way when the touch met nothing.
+    {
+      const Vec3d d = pick.direction.normalized();
+      double stop = pick.max_distance;
+      for (const auto& c : contacts) stop = std::min(stop, (c.position - pick.origin).dot(d));
+      explorer.add_free_space(pick.origin, pick.origin + std::max(0.0, stop - 0.002) * d);
+    }
     all.insert(all.end(), contacts.begin(), contacts.end());
     TouchRecord r;
     r.touch = k;

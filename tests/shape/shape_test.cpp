@@ -11,6 +11,7 @@
 #include <random>
 #include <set>
 #include <taxel/shape.hpp>
+#include <taxel/sim/exploration.hpp>
 #include <utility>
 #include <vector>
 
@@ -536,4 +537,91 @@ TEST_CASE("score_touches: the gain equals a brute-force refit", "[shape][touch]"
                     Catch::Contains("noise_sigma"));
   CHECK_THROWS_WITH(sh::score_touches(surface, grid, std::vector<double>(3), targets, cands),
                     Catch::Contains("does not fit"));
+}
+
+TEST_CASE("ImplicitSurface: free-space points observe the field's value", "[shape][surface]") {
+  sh::ImplicitSurface surface({.expert_size = 0.01, .min_sigma = 1e-6, .prior_radius = 0.02});
+  const Vec3d x(0.005, 0.001, 0.012);
+  const double before = surface.mean(x);
+  const auto id = surface.insert_free(x, 0.004, 1e-12);
+  REQUIRE(id);
+  CHECK(surface.mean(x) == Approx(0.004).margin(1e-6));
+  CHECK(surface.predict(x).variance < 1e-9);
+  CHECK_FALSE(surface.update(*id, x, Vec3d::UnitZ(), 0.0));
+  CHECK_FALSE(surface.insert_free(x, NAN, 1e-6));
+  CHECK_FALSE(surface.insert_free(x, 0.001, -1.0));
+  surface.erase(*id);
+  CHECK(surface.mean(x) == Approx(before).margin(1e-15));
+}
+
+TEST_CASE("Explorer: the incrementally resampled field equals a fresh sample",
+          "[shape][explorer]") {
+  sh::Explorer<> ex({.workspace_min = Vec3d::Constant(-0.03),
+                     .workspace_max = Vec3d::Constant(0.03),
+                     .grid_spacing = 0.003});
+  std::mt19937_64 rng(23);
+  std::normal_distribution<double> g;
+  const auto batch = [&](double z, int n) {
+    std::vector<taxel::Contact<double>> out;
+    for (int i = 0; i < n; ++i) {
+      taxel::Contact<double> c;
+      c.position = Vec3d(0.004 * g(rng), 0.004 * g(rng), z + 1e-4 * g(rng));
+      c.normal = Vec3d::UnitZ();
+      c.covariance = taxel::Mat3d(Eigen::Vector3d(1e-6, 1e-6, 1e-8).asDiagonal());
+      out.push_back(c);
+    }
+    return out;
+  };
+  const auto first = batch(0.015, 200);
+  CHECK(ex.add_contacts(first) > 10);
+  CHECK(ex.surface().size() == ex.cloud().size());
+  const std::vector<double> before = ex.field();
+  const auto second = batch(0.015, 100);
+  CHECK(ex.add_contacts(second) > 0);
+  CHECK(ex.add_free_space(Vec3d(0.0, 0.0, -0.05), Vec3d(0.0, 0.0, 0.01)) > 0);
+  const std::vector<double> now = ex.field();
+  const std::vector<double> fresh = ex.surface().sample(ex.grid());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < now.size(); ++i) worst = std::max(worst, std::abs(now[i] - fresh[i]));
+  CHECK(worst < 1e-12);
+  CHECK(now != before);
+  // Every fused point is in the surface at its fused position.
+  for (std::size_t i = 0; i < ex.cloud().size(); ++i) {
+    bool found = false;
+    for (std::size_t s = 0; s < ex.surface().id_count() && !found; ++s) {
+      const auto& p = ex.surface().point(s);
+      found = p.alive && !p.free &&
+              (p.position - ex.cloud().mean(static_cast<taxel::index::PointId>(i))).norm() < 1e-15;
+    }
+    CHECK(found);
+  }
+  // The estimate passes through the touched patch, with a small sigma there.
+  const sh::SurfaceMesh& mesh = ex.estimate();
+  REQUIRE_FALSE(mesh.mesh.triangles.empty());
+  double near_sigma = 1.0;
+  for (std::size_t v = 0; v < mesh.mesh.vertices.size(); ++v) {
+    if ((mesh.mesh.vertices[v] - Vec3d(0, 0, 0.015)).norm() < 0.003)
+      near_sigma = std::min(near_sigma, mesh.sigma[v]);
+  }
+  CHECK(near_sigma < 1e-3);
+  CHECK_THROWS_WITH(sh::Explorer<>({.free_cap = 0.0}), Catch::Contains("free_cap"));
+}
+
+TEST_CASE("sim::poke meets the surface where the ray does, and misses cleanly", "[shape][sim]") {
+  const taxel::sim::Sphere ball(0.03);
+  taxel::sim::ExplorationConfig cfg;
+  std::mt19937_64 rng(29);
+  std::vector<taxel::Contact<double>> contacts;
+  const Vec3d origin(0.01, 0.0, 0.1), dir(0.0, 0.0, -1.0);
+  const auto hit = taxel::sim::poke(ball, cfg, origin, dir, 0.2, rng, contacts);
+  REQUIRE(hit);
+  CHECK((*hit - Vec3d(0.01, 0.0, std::sqrt(0.03 * 0.03 - 0.01 * 0.01))).norm() < 1e-8);
+  REQUIRE(contacts.size() > 20);
+  for (const auto& c : contacts) CHECK(std::abs(c.position.norm() - 0.03) < 0.002);
+  contacts.clear();
+  CHECK_FALSE(taxel::sim::poke(ball, cfg, Vec3d(0.05, 0.0, 0.1), dir, 0.2, rng, contacts));
+  CHECK(contacts.empty());
+  CHECK_FALSE(taxel::sim::poke(ball, cfg, origin, dir, 0.05, rng, contacts));  // too short
+  CHECK_THROWS_WITH(taxel::sim::poke(ball, cfg, origin, Vec3d::Zero(), 0.2, rng, contacts),
+                    Catch::Contains("direction of length > 0"));
 }

@@ -37,6 +37,14 @@ struct ExplorerConfig {
   /// Re-fit the prior sphere's radius to the points' mean distance from its centre after
   /// every batch (the centre stays surface.prior_centre); off keeps surface.prior_radius.
   bool fit_prior_radius = true;
+  /// Free space (add_free_space): spacing of the points along a path, > 0.
+  double free_spacing = 5e-3;
+  /// Free space: points where the posterior mean is above this are left out (they say what
+  /// the estimate already says), > 0.
+  double free_threshold = 5e-3;
+  /// Free space: the value a point observes is its distance along the path to the path's
+  /// end, at most this; its noise standard deviation is half the value. > 0.
+  double free_cap = 3e-3;
 };
 
 /// Fused cloud, implicit surface, sampled field, mesh and touch scoring for one object (see
@@ -80,6 +88,35 @@ class Explorer {
     return changed.size();
   }
 
+  /// Tells the surface that the segment from `from` to `to` is free (a finger moved through
+  /// it, e.g. along its approach up to the contact, or the whole ray of a touch that met
+  /// nothing): points every free_spacing inside the workspace where the estimate puts the
+  /// surface near or beyond them become observations of the field's being positive there.
+  /// Returns how many points were added.
+  std::size_t add_free_space(const Vec3d& from, const Vec3d& to) {
+    if (!from.allFinite() || !to.allFinite()) return 0;
+    const double length = (to - from).norm();
+    const auto steps =
+        static_cast<std::size_t>(std::min(1e6, std::floor(length / config_.free_spacing)));
+    std::size_t added = 0;
+    for (std::size_t i = 0; i <= steps; ++i) {
+      const Vec3d x =
+          to + (from - to) * (length > 0.0 ? double(i) * config_.free_spacing / length : 0.0);
+      if ((x - config_.workspace_min).minCoeff() < 0.0 ||
+          (config_.workspace_max - x).minCoeff() < 0.0)
+        continue;
+      if (surface_.mean(x) > config_.free_threshold) continue;
+      const double value = std::min(double(i) * config_.free_spacing, config_.free_cap);
+      if (!(value > 0.0)) continue;
+      if (surface_.insert_free(x, value, 0.25 * value * value)) ++added;
+    }
+    if (added > 0) {
+      fresh_ = false;
+      mesh_.reset();
+    }
+    return added;
+  }
+
   /// The fused contacts.
   [[nodiscard]] const Cloud& cloud() const noexcept { return cloud_; }
   /// The implicit surface.
@@ -118,6 +155,11 @@ class Explorer {
   static const ExplorerConfig& checked(const ExplorerConfig& c) {
     c.surface.validate();
     c.scoring.validate();
+    for (const double v : {c.free_spacing, c.free_threshold, c.free_cap}) {
+      if (!(v > 0.0) || !std::isfinite(v))
+        throw std::invalid_argument(
+            "ExplorerConfig: free_spacing, free_threshold and free_cap must be finite and > 0");
+    }
     (void)K(c.kernel);
     (void)Grid::covering(c.workspace_min, c.workspace_max, c.grid_spacing);
     return c;

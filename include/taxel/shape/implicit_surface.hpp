@@ -95,7 +95,7 @@ template <Kernel K = Matern32>
 class ImplicitSurface {
  public:
   /// One expert: its process and, per observation, the point it came from (id * 4 + kind,
-  /// kind 0 on the surface, 1 outside, 2 inside).
+  /// kind 0 on the surface, 1 outside, 2 inside, 3 free space).
   struct Expert {
     CellIndex cell{};                   ///< the cell it owns: [cell, cell + 1) * expert_size
     GaussianProcess<K> process;         ///< the process of its observations, minus the prior mean
@@ -107,6 +107,9 @@ class ImplicitSurface {
     Vec3d normal = Vec3d::UnitZ();   ///< outward unit normal
     double variance = 0.0;           ///< along the normal [m^2], before the floor
     bool alive = false;              ///< false once erased
+    /// A free-space point (insert_free): one observation of `value` at the position, no normal.
+    bool free = false;
+    double value = 0.0;  ///< the observed field at a free-space point [m]
   };
 
   /// Throws std::invalid_argument for an invalid configuration.
@@ -142,11 +145,25 @@ class ImplicitSurface {
     return id;
   }
 
+  /// Adds a free-space observation: the field at `x` is `value` (> 0: outside the object, e.g.
+  /// a point the robot's finger passed through) with noise variance `variance` [m^2]. Returns
+  /// its id, or nothing (and the surface unchanged) for a non-finite input or a negative
+  /// variance. Erased like a surface point; update() refuses it.
+  std::optional<std::size_t> insert_free(const Vec3d& x, double value, double variance) {
+    if (!valid(x, Vec3d::UnitZ(), variance) || !std::isfinite(value)) return std::nullopt;
+    const std::size_t id = points_.size();
+    points_.push_back({x, Vec3d::Zero(), variance, true, true, value});
+    ++alive_;
+    attach(id);
+    return id;
+  }
+
   /// Moves point `id` to `p` with `normal` and `variance` (a fused point that moved). Returns
   /// false, and changes nothing, for an invalid input. Throws std::out_of_range for an id never
   /// handed out or erased.
   bool update(std::size_t id, const Vec3d& p, const Vec3d& normal, double variance) {
     check_id(id, "update");
+    if (points_[id].free) return false;
     if (!valid(p, normal, variance)) return false;
     detach(id);
     points_[id] = {p, normal.normalized(), variance, true};
@@ -391,11 +408,14 @@ class ImplicitSurface {
     for (const Expert& e : experts_) n = std::max(n, e.process.size());
     return n;
   }
-  /// Position and value of an observation, from its owner code (id * 4 + kind).
+  /// Position and value of an observation, from its owner code (id * 4 + kind; kind 3 is a
+  /// free-space point's).
   [[nodiscard]] std::pair<Vec3d, double> observation(std::uint64_t owner) const {
     const Point& p = points_[owner / 4];
     const double d = config_.normal_offset;
     switch (owner % 4) {
+      case 3:
+        return {p.position, p.value};
       case 1:
         return {p.position + d * p.normal, d};
       case 2:
@@ -517,7 +537,9 @@ class ImplicitSurface {
     for (int c = 0; c < 8; ++c) {
       Expert& e = expert({base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + ((c >> 2) & 1)});
       for (int kind = 0; kind < kinds(); ++kind) {
-        const std::uint64_t owner = std::uint64_t(id) * 4 + std::uint64_t(kind);
+        const std::uint64_t owner =
+            std::uint64_t(id) * 4 + std::uint64_t(points_[id].free ? 3 : kind);
+        if (points_[id].free && kind > 0) break;
         const auto [x, v] = observation(owner);
         if (e.process.add(x, v - prior(x), nv)) e.owners.push_back(owner);
       }
