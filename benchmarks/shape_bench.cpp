@@ -15,10 +15,10 @@ namespace sh = taxel::shape;
 using taxel::Vec3d;
 
 // A sphere of radius 30 mm densely touched: points on a Fibonacci sphere, as many as gives
-// `per_expert` points to an expert of side 10 mm (it holds the points of a 20 mm cube).
+// `per_expert` points to an expert of side 15 mm (it holds the points of a 30 mm cube).
 sh::ImplicitSurface<> touched_sphere(std::size_t per_expert) {
-  const double r = 0.03, L = 0.01;
-  // A 20 mm cube centred on the sphere holds about (2L)^2 of its surface.
+  const double r = 0.03, L = 0.015;
+  // A cube of side 2 L centred on the sphere holds about (2 L)^2 of its surface.
   const auto n = static_cast<int>(double(per_expert) * 4 * 3.14159 * r * r / (4 * L * L));
   sh::ImplicitSurface<> s({.expert_size = L, .prior_radius = 0.025});
   for (int i = 0; i < n; ++i) {

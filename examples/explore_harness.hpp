@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -150,12 +149,6 @@ std::vector<TouchRecord> explore(const Sh& shape, Settings s, OnTouch&& on_touch
   s.explorer.grid_spacing = s.grid_spacing;
   s.explorer.surface.prior_centre = Vec3d::Zero();
   s.explorer.surface.prior_radius = 0.5 * reach;
-  if (const char* v = std::getenv("TX_RADIUS")) s.explorer.scoring.radius = std::atof(v);
-  if (const char* v = std::getenv("TX_PATCH")) s.explorer.scoring.patch_points = std::atoi(v);
-  if (const char* v = std::getenv("TX_PATCH_R")) s.explorer.scoring.patch_radius = std::atof(v);
-  if (const char* v = std::getenv("TX_CAND")) s.candidates = std::atoi(v);
-  if (const char* v = std::getenv("TX_L")) s.explorer.kernel.length_scale = std::atof(v);
-  if (const char* v = std::getenv("TX_E")) s.explorer.surface.expert_size = std::atof(v);
   tsh::Explorer<> explorer(s.explorer);
   std::vector<TouchRecord> out;
   std::vector<taxel::Contact<double>> contacts, all;

@@ -4,7 +4,7 @@ include(${CMAKE_CURRENT_LIST_DIR}/cli_common.cmake)
 run_tool("${DEMO}" 0 --quick out)
 
 # Every file the page shows or links.
-set(files index.html error_vs_contacts.svg)
+set(files index.html error_vs_contacts.svg active_touch_estimate.ply)
 foreach(object sphere-40 cylinder-30x100 box-80x60x40 cone-30x60)
   list(APPEND files ${object}_surfel.svg)
   foreach(policy raw average kalman)

@@ -363,6 +363,7 @@ void bind_image(py::module_& m);
 void bind_learn(py::module_& m);
 void bind_io(py::module_& m);
 void bind_sim(py::module_& m);
+void bind_shape(py::module_& m);
 void bind_optical(py::module_& m);
 
 }  // namespace taxel::python

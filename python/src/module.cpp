@@ -24,4 +24,5 @@ PYBIND11_MODULE(_taxel, m) {
   tp::bind_io(m);
   tp::bind_sim(m);
   tp::bind_optical(m);
+  tp::bind_shape(m);
 }

@@ -9,10 +9,10 @@ import sys as _sys
 
 from . import _taxel
 from ._taxel import Contacts, IoError, PointCloud, ProtocolError, __version__
-from ._taxel import fusion, image, index, io, optical, registration, sensor, sim
+from ._taxel import fusion, image, index, io, optical, registration, sensor, shape, sim
 
 # `import taxel.fusion` and `from taxel.image import segment` work like for any package.
-for _name in ("fusion", "image", "index", "io", "optical", "registration", "sensor", "sim"):
+for _name in ("fusion", "image", "index", "io", "optical", "registration", "sensor", "shape", "sim"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_taxel, _name)
 
 from . import learn  # noqa: E402 - the estimators over the compiled taxel._taxel.learn
@@ -58,6 +58,7 @@ __all__ = [
     "optical",
     "registration",
     "sensor",
+    "shape",
     "sim",
 ]
 
@@ -67,4 +68,4 @@ _reprs.install(_sys.modules[__name__])
 
 from . import _errors  # noqa: E402
 
-_errors.install(_taxel, fusion, image, index, io, optical, registration, sensor, sim)
+_errors.install(_taxel, fusion, image, index, io, optical, registration, sensor, shape, sim)

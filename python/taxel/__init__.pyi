@@ -15,6 +15,7 @@ import taxel.learn
 import taxel.optical
 import taxel.registration
 import taxel.sensor
+import taxel.shape
 import taxel.sim
 
 
@@ -73,4 +74,5 @@ from taxel import learn as learn
 from taxel import optical as optical
 from taxel import registration as registration
 from taxel import sensor as sensor
+from taxel import shape as shape
 from taxel import sim as sim

@@ -15,6 +15,7 @@ import taxel.learn
 import taxel.optical
 import taxel.registration
 import taxel.sensor
+import taxel.shape
 import taxel.sim
 
 

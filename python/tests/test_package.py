@@ -38,7 +38,7 @@ def test_version_and_submodules():
     assert importlib.import_module("taxel.image").segment is taxel._taxel.image.segment
 
 
-SUBMODULES = ("fusion", "image", "index", "io", "learn", "optical", "registration", "sensor", "sim")
+SUBMODULES = ("fusion", "image", "index", "io", "learn", "optical", "registration", "sensor", "shape", "sim")
 
 
 def _doc_text(obj, name):

@@ -137,7 +137,7 @@ def test_every_class_is_covered():
     import copyreg
 
     missing = []
-    for sub in ("fusion", "image", "io", "optical", "registration", "sensor", "sim"):
+    for sub in ("fusion", "image", "io", "optical", "registration", "sensor", "shape", "sim"):
         mod = getattr(taxel, sub)
         for name, cls in vars(mod).items():
             if not inspect.isclass(cls) or issubclass(cls, BaseException) or name.startswith("_"):

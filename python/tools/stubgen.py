@@ -17,7 +17,7 @@ import sys
 import taxel
 from taxel import _taxel
 
-SUBMODULES = ("fusion", "image", "index", "io", "optical", "registration", "sensor", "sim")
+SUBMODULES = ("fusion", "image", "index", "io", "optical", "registration", "sensor", "shape", "sim")
 # Pure-Python submodules: typed inline (py.typed), so they get no stub of their own.
 PYTHON_MODULES = ("learn",)
 F64 = "numpy.typing.NDArray[numpy.float64]"
@@ -42,6 +42,11 @@ RETURNS = {
     "optical.reconstruct": "taxel.optical.HeightMapResult",
     "registration.Target.nearest": f"typing.Tuple[numpy.typing.NDArray[numpy.int64], {F64}]",
     "registration.model_cloud": "typing.Tuple[taxel.PointCloud, str]",
+    "shape.ImplicitSurface.mesh": "taxel.shape.SurfaceMesh",
+    "shape.ImplicitSurface.predict": f"typing.Tuple[{F64}, {F64}, {F64}]",
+    "shape.ImplicitSurface.score_touches": "taxel.shape.TouchScores",
+    "shape.approach_rays": f"typing.Tuple[{F64}, {F64}]",
+    "shape.marching_tetrahedra": f"typing.Tuple[{F64}, numpy.typing.NDArray[numpy.uint32]]",
     "sim.PalmGraspSynth.dataset": "taxel.sim.GraspDataset",
     "sim.surface_error": "taxel.sim.SurfaceError",
 }
@@ -74,6 +79,10 @@ TYPED_DICTS = {
         },
     },
     "optical": {"HeightMapResult": {"height": F64, "gx": F64, "gy": F64, "mask": B, "contact": B}},
+    "shape": {
+        "SurfaceMesh": {"vertices": F64, "triangles": "numpy.typing.NDArray[numpy.uint32]", "sigma": F64, "normals": F64},
+        "TouchScores": {"contact": B, "point": F64, "normal": F64, "gain": F64},
+    },
     "sim": {
         "SurfaceError": {"signed_mean": "float", "mean": "float", "rms": "float", "max": "float"},
         "GraspDataset": {

@@ -25,10 +25,10 @@ import sys
 import tempfile
 
 # Pages that measure rather than guide: long tables and lab notes are allowed there.
-MEASUREMENT_PAGES = {"fusion-study.md", "recognition-study.md", "performance.md"}
+MEASUREMENT_PAGES = {"fusion-study.md", "recognition-study.md", "active-touch-study.md", "performance.md"}
 MAX_PARAGRAPH_LINES = 8
 MAX_README_LINES = 200
-TOOL = re.compile(r"^(taxel-[a-z]+|0[1-9]_[a-z_]+)$")
+TOOL = re.compile(r"^(taxel-[a-z]+|[0-9][0-9]_[a-z_]+)$")
 
 
 def pages(root):

@@ -625,3 +625,24 @@ TEST_CASE("sim::poke meets the surface where the ray does, and misses cleanly", 
   CHECK_THROWS_WITH(taxel::sim::poke(ball, cfg, origin, Vec3d::Zero(), 0.2, rng, contacts),
                     Catch::Contains("direction of length > 0"));
 }
+
+TEST_CASE("confidence_region: with no touch, the prior sphere widened by k prior sigmas",
+          "[shape][surface]") {
+  // No observations: mean = |x| - r, sigma = s_f everywhere, so the shells are spheres of
+  // radius r - k s_f and r + k s_f (a closed form).
+  const double r = 0.03, sf = 0.005, k = 2.0, h = 0.002;
+  sh::ImplicitSurface surface({.prior_radius = r},
+                              sh::Matern32({.length_scale = 0.02, .sigma = sf}));
+  const sh::Grid grid = sh::Grid::covering(Vec3d::Constant(-0.05), Vec3d::Constant(0.05), h);
+  const sh::ConfidenceRegion region = sh::confidence_region(surface, grid, k);
+  const auto radii = [](const sh::Mesh& m, double want) {
+    double worst = 0.0;
+    for (const Vec3d& v : m.vertices) worst = std::max(worst, std::abs(v.norm() - want));
+    return worst;
+  };
+  REQUIRE_FALSE(region.inner.triangles.empty());
+  REQUIRE_FALSE(region.outer.triangles.empty());
+  CHECK(radii(region.inner, r - k * sf) <= 3 * h * h / 8 / (r - k * sf - std::sqrt(3.0) * h));
+  CHECK(radii(region.outer, r + k * sf) <= 3 * h * h / 8 / (r + k * sf - std::sqrt(3.0) * h));
+  CHECK_THROWS_WITH(sh::confidence_region(surface, grid, 0.0), Catch::Contains("k must be"));
+}

@@ -6,12 +6,12 @@
 // n and variance s^2 along n gives three observations: f(p) = 0, f(p + d n) = d and
 // f(p - d n) = -d (d the normal offset), each with noise variance s^2.
 //
-// The prior mean is the signed distance to a sphere, m(x) = |x - c| - r (Martens, Poffet, Yang
-// and Hausman, "Geometric priors for Gaussian process implicit surfaces", IEEE RA-L 2017), so
-// that the field is a closed surface far from every touch; the process models f - m.
+// The prior mean is the signed distance to a sphere, m(x) = |x - c| - r (Martens et al.,
+// "Geometric priors for Gaussian process implicit surfaces", IEEE RA-L 2017), so that the
+// field is a closed surface far from every touch; the process models f - m.
 //
-// Local experts (after Lee, Zhang and Lee, "Online continuous mapping using Gaussian process
-// implicit surfaces", ICRA 2019): space is cut into cubic cells of side L, the expert size.
+// Local experts (after Lee et al., "Online continuous mapping using Gaussian process implicit
+// surfaces", ICRA 2019): space is cut into cubic cells of side L, the expert size.
 // Expert c owns cell c and holds, in an exact Gaussian process of its own, the observations of
 // the points within L/2 of its cell (a cube of side 2 L), so a point lives in the 8 experts
 // around it, and adding it extends their Cholesky factors by one row per observation (O(n^2)
@@ -51,7 +51,7 @@ namespace taxel::shape {
 struct SurfaceConfig {
   /// L: spacing of the experts; each holds the points within L of it along every axis, so its
   /// size grows with L^2 of touched surface. Finite and > 0.
-  double expert_size = 0.01;
+  double expert_size = 0.015;
   /// d: the off-surface observations' distance along the normal; 0 leaves them out (the
   /// normals then go unused). Finite and >= 0.
   double normal_offset = 0.003;

@@ -46,7 +46,7 @@ inline void check_kernel(const char* name, double length_scale, double sigma) {
 
 /// Settings of the Matern kernels. The field is a distance, so both are lengths.
 struct MaternConfig {
-  double length_scale = 0.01;  ///< l [m]: how far a touch informs the surface
+  double length_scale = 0.02;  ///< l [m]: how far a touch informs the surface
   double sigma = 0.01;         ///< s [m]: the field's prior standard deviation
 };
 

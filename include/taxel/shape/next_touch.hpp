@@ -2,8 +2,9 @@
 // Where to touch next: each candidate touch is an approach ray the robot can follow. Its
 // contact is predicted on the current estimate (the first crossing of the posterior mean's
 // zero level along the ray), and it is scored by the expected reduction of the surface's
-// uncertainty, as in GPAtlasRRT (Rosales, Suarez and Shemonski, IJHR 2018) touches go where
-// the surface is least certain. A touch observes the field (value 0) at its contact and at
+// uncertainty: as in GPAtlasRRT (Rosales et al., "GPAtlasRRT: a local tactile exploration
+// planner for recovering the shape of novel objects", IJHR 2018), touches go where the surface
+// is least certain. A touch observes the field (value 0) at its contact and at
 // `patch_points` points on a circle of `patch_radius` around it in the predicted tangent plane,
 // each with noise sigma^2. With the expert e nearest the contact, whose posterior covariance is
 // C(a, b) = k(|a - b|) - v(a)' v(b) (GaussianProcess::whiten), those observations O lower the

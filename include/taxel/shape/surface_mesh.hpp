@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "taxel/core/point_cloud.hpp"
@@ -64,6 +65,47 @@ template <Kernel K>
     (void)surface.mean(out.mesh.vertices[i], g);
     out.normals[i] = g.norm() > 0.0 ? Vec3d(g.normalized()) : Vec3d::UnitZ();
   }
+  return out;
+}
+
+/// The confidence region of the surface: between `inner`, where mean + k sigma = 0, and
+/// `outer`, where mean - k sigma = 0 (sigma the field's posterior standard deviation). With the
+/// field about a distance, the surface lies between them with the probability of k sigmas of
+/// a normal distribution (about 95 % for k = 2) at each point.
+struct ConfidenceRegion {
+  Mesh inner;      ///< the level set mean + k sigma = 0 (inside the estimate)
+  Mesh outer;      ///< the level set mean - k sigma = 0 (outside it)
+  double k = 2.0;  ///< the number of standard deviations
+};
+
+/// The confidence region of `surface` on `grid` (see ConfidenceRegion), both meshes closed at
+/// the grid's border. Costs a variance per grid node. Throws std::invalid_argument for an
+/// invalid grid or k not finite and > 0.
+template <Kernel K>
+[[nodiscard]] ConfidenceRegion confidence_region(const ImplicitSurface<K>& surface,
+                                                 const Grid& grid, double k = 2.0) {
+  if (!(k > 0.0) || !std::isfinite(k))
+    throw std::invalid_argument("confidence_region: k must be finite and > 0");
+  grid.validate();
+  Eigen::Matrix3Xd nodes(3, static_cast<Eigen::Index>(grid.size()));
+  for (int c = 0; c < grid.nodes[2]; ++c) {
+    for (int b = 0; b < grid.nodes[1]; ++b) {
+      for (int a = 0; a < grid.nodes[0]; ++a)
+        nodes.col(static_cast<Eigen::Index>(grid.index(a, b, c))) = grid.node(a, b, c);
+    }
+  }
+  std::vector<double> mean(grid.size()), var(grid.size());
+  surface.evaluate(nodes, mean.data(), var.data());
+  std::vector<double> lo(grid.size()), hi(grid.size());
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const double s = k * std::sqrt(var[i]);
+    lo[i] = mean[i] + s;
+    hi[i] = mean[i] - s;
+  }
+  ConfidenceRegion out;
+  out.k = k;
+  out.inner = marching_tetrahedra(grid, lo, 0.0, true);
+  out.outer = marching_tetrahedra(grid, hi, 0.0, true);
   return out;
 }
 

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: MIT
-// 07: does choosing where to touch pay? For six shapes and three seeds, a simulated pad pokes
+// 10: does choosing where to touch pay? For six shapes and three seeds, a simulated pad pokes
 // each object 40 times along random approach rays, and again along the rays the active policy
 // picks (the largest expected drop of the surface's variance, taxel::shape). The table gives the
 // random policy's surface error after 40 touches and the touch at which the active policy first
 // reaches it (the GPAtlasRRT comparison of Rosales et al., IJHR 2018). Then recognition: each
 // of ten models of different shapes, at random poses, explored for 10 touches with either
 // policy; the share of trials whose most probable model is the right one after each touch.
-//   ./07_active_touch_study [--quick] [--out DIR] [--threads N]
+//   ./10_active_touch_study [--quick] [--out DIR] [--threads N]
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -74,7 +74,7 @@ int reached(const std::vector<taxel_explore::TouchRecord>& run, double target) {
 int main(int argc, char** argv) {
   unsigned threads = 0;
   const taxel_cli::StudyOptions opt = taxel_cli::parse_study_options(
-      "07_active_touch_study", "usage: 07_active_touch_study [--quick] [--out DIR] [--threads N]\n",
+      "10_active_touch_study", "usage: 10_active_touch_study [--quick] [--out DIR] [--threads N]\n",
       "", argc, argv, [&](std::string_view a, taxel_cli::Args& args) {
         if (a != "--threads") return false;
         threads = args.number<unsigned>(0, 4096);

@@ -1,0 +1,408 @@
+// SPDX-License-Identifier: MIT
+// taxel.shape: the Gaussian-process implicit surface with its uncertainty, its mesh, and the
+// scoring of candidate touches.
+#include <random>
+
+#include "common.hpp"
+#include "taxel/shape/implicit_surface.hpp"
+#include "taxel/shape/marching.hpp"
+#include "taxel/shape/next_touch.hpp"
+#include "taxel/shape/surface_mesh.hpp"
+
+namespace taxel::python {
+namespace {
+
+namespace sh = taxel::shape;
+using Surface = sh::ImplicitSurface<sh::Matern32>;
+
+Vec3d vec3(const ArrayD& a, const char* what) {
+  require_shape(a, {3}, what, "(3,)");
+  return {a.data()[0], a.data()[1], a.data()[2]};
+}
+
+ArrayD vec_array(const Vec3d& v) {
+  ArrayD out(py::ssize_t{3});
+  store(out.mutable_data(), v);
+  return out;
+}
+
+Surface make_surface(double expert_size, double normal_offset, double blend, double min_sigma,
+                     const std::optional<ArrayD>& prior_centre, double prior_radius,
+                     double length_scale, double sigma) {
+  sh::SurfaceConfig c;
+  c.expert_size = expert_size;
+  c.normal_offset = normal_offset;
+  c.blend = blend;
+  c.min_sigma = min_sigma;
+  c.prior_centre = prior_centre ? vec3(*prior_centre, "prior_centre") : Vec3d::Zero();
+  c.prior_radius = prior_radius;
+  try {
+    return Surface(c, sh::Matern32({.length_scale = length_scale, .sigma = sigma}));
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+sh::Grid grid_from(const ArrayD& lo, const ArrayD& hi, double spacing) {
+  try {
+    return sh::Grid::covering(vec3(lo, "lo"), vec3(hi, "hi"), spacing);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+py::dict mesh_dict(const sh::SurfaceMesh& m) {
+  py::array_t<std::uint32_t> tri(
+      {static_cast<py::ssize_t>(m.mesh.triangles.size()), py::ssize_t{3}});
+  if (!m.mesh.triangles.empty())
+    std::memcpy(tri.mutable_data(), m.mesh.triangles.data(), m.mesh.triangles.size() * 3 * 4);
+  py::dict d;
+  d["vertices"] = points_array(m.mesh.vertices);
+  d["triangles"] = tri;
+  d["sigma"] = vector_array(m.sigma);
+  d["normals"] = points_array(m.normals);
+  return d;
+}
+
+constexpr const char* kSurfaceDoc = R"doc(
+A Gaussian-process implicit surface over local experts: a field f, negative inside, zero on
+the surface, positive outside, about the signed distance near it, with a posterior variance
+everywhere. Each surface point observes f = 0 there and f = +-d at +-d along its normal
+(d = normal_offset); free-space points observe a positive value. The prior mean is the signed
+distance to the sphere (prior_centre, prior_radius); the kernel is Matern 3/2 with length_scale
+and sigma (scikit-learn's ConstantKernel(sigma**2) * Matern(length_scale, nu=1.5)). Experts of
+side expert_size each keep an exact process of the points within half a side of their cube;
+adding or moving a point updates 8 of them by rank-one steps, never a refit. Lengths in metres.
+Calls from several threads run one at a time (queries together) and release the GIL.)doc";
+
+}  // namespace
+
+void bind_shape(py::module_& root) {
+  py::module_ m = root.def_submodule("shape", R"doc(
+Shape with uncertainty: a Gaussian-process implicit surface built from fused points (their
+normals and variances), queried for mean, variance and gradient, meshed with each vertex's
+standard deviation, and candidate touches (approach rays) scored by the expected drop of the
+surface's variance. Lengths in metres.)doc");
+
+  py::class_<Surface> cls(m, "ImplicitSurface", kSurfaceDoc);
+  pickle_with(
+      cls, "ImplicitSurface",
+      [](const Surface& s) {
+        const auto lock = read_lock(&s);
+        const sh::SurfaceConfig& c = s.config();
+        const std::size_t n = s.id_count();
+        std::vector<Vec3d> pos(n), nor(n);
+        std::vector<double> var(n), val(n);
+        std::vector<std::uint8_t> alive(n), free(n);
+        for (std::size_t i = 0; i < n; ++i) {
+          const auto& p = s.point(i);
+          pos[i] = p.position;
+          nor[i] = p.normal;
+          var[i] = p.variance;
+          val[i] = p.value;
+          alive[i] = p.alive;
+          free[i] = p.free;
+        }
+        return py::make_tuple(c.expert_size, c.normal_offset, c.blend, c.min_sigma,
+                              vec_array(c.prior_centre), c.prior_radius,
+                              s.kernel().config().length_scale, s.kernel().config().sigma,
+                              points_array(pos), points_array(nor), vector_array(var),
+                              vector_array(val), vector_array(alive), vector_array(free));
+      },
+      [](const py::tuple& a) {
+        if (a.size() != 14) throw py::value_error("ImplicitSurface: damaged pickled state");
+        Surface s = make_surface(a[0].cast<double>(), a[1].cast<double>(), a[2].cast<double>(),
+                                 a[3].cast<double>(), a[4].cast<ArrayD>(), a[5].cast<double>(),
+                                 a[6].cast<double>(), a[7].cast<double>());
+        const std::vector<Vec3d> pos = points_from(a[8].cast<ArrayD>(), "positions");
+        const std::vector<Vec3d> nor = points_from(a[9].cast<ArrayD>(), "normals");
+        const auto var = a[10].cast<std::vector<double>>();
+        const auto val = a[11].cast<std::vector<double>>();
+        const auto alive = a[12].cast<std::vector<std::uint8_t>>();
+        const auto free = a[13].cast<std::vector<std::uint8_t>>();
+        if (nor.size() != pos.size() || var.size() != pos.size() || val.size() != pos.size() ||
+            alive.size() != pos.size() || free.size() != pos.size())
+          throw py::value_error("ImplicitSurface: damaged pickled state");
+        for (std::size_t i = 0; i < pos.size(); ++i) {
+          // Erased points are added and erased again, so that every id keeps its point.
+          const auto id =
+              free[i] ? s.insert_free(pos[i], val[i], var[i])
+                      : s.insert(pos[i], nor[i].norm() > 0 ? nor[i] : Vec3d::UnitZ(), var[i]);
+          if (!id || *id != i) throw py::value_error("ImplicitSurface: damaged pickled state");
+          if (!alive[i]) s.erase(i);
+        }
+        return s;
+      });
+  cls.def(py::init(&make_surface), py::kw_only(), py::arg("expert_size") = 0.015,
+          py::arg("normal_offset") = 0.003, py::arg("blend") = 0.1, py::arg("min_sigma") = 0.2e-3,
+          py::arg("prior_centre") = py::none(), py::arg("prior_radius") = 0.0,
+          py::arg("length_scale") = 0.02, py::arg("sigma") = 0.01,
+          "An empty surface (prior_centre None: the origin); ValueError naming a setting out "
+          "of range.")
+      .def("__len__", [](const Surface& s) { return s.size(); })
+      .def("__repr__",
+           [](const Surface& s) {
+             char text[200];
+             std::snprintf(text, sizeof text,
+                           "ImplicitSurface(%zu points, %zu experts, expert_size=%g, "
+                           "length_scale=%g, prior_radius=%g)",
+                           s.size(), s.expert_count(), s.config().expert_size,
+                           s.kernel().config().length_scale, s.config().prior_radius);
+             return std::string(text);
+           })
+      .def_property_readonly("expert_count", &Surface::expert_count, "number of experts")
+      .def_property_readonly(
+          "prior_centre", [](const Surface& s) { return vec_array(s.config().prior_centre); },
+          "centre of the prior sphere [m]")
+      .def_property_readonly(
+          "prior_radius", [](const Surface& s) { return s.config().prior_radius; },
+          "radius of the prior sphere [m]")
+      .def(
+          "insert",
+          [](Surface& s, const ArrayD& points, const ArrayD& normals,
+             const std::optional<ArrayD>& variances) {
+            const std::vector<Vec3d> p = points_from(points, "points");
+            const std::vector<Vec3d> n = points_from(normals, "normals");
+            if (n.size() != p.size())
+              throw py::value_error("insert: points and normals differ in length");
+            std::vector<double> v(p.size(), 0.0);
+            if (variances) {
+              require_shape(*variances, {static_cast<py::ssize_t>(p.size())}, "variances", "(N,)");
+              std::memcpy(v.data(), variances->data(), v.size() * sizeof(double));
+            }
+            py::array_t<std::int64_t> ids(static_cast<py::ssize_t>(p.size()));
+            std::int64_t* out = ids.mutable_data();
+            py::gil_scoped_release release;
+            const auto lock = write_lock(&s);
+            for (std::size_t i = 0; i < p.size(); ++i) {
+              const auto id = s.insert(p[i], n[i], v[i]);
+              out[i] = id ? static_cast<std::int64_t>(*id) : -1;
+            }
+            return ids;
+          },
+          py::arg("points"), py::arg("normals"), py::arg("variances") = py::none(),
+          "Adds (N, 3) surface points with (N, 3) outward normals and (N,) variances along "
+          "them [m^2] (default 0: the min_sigma floor). Returns their ids (int64), -1 for a "
+          "point refused (not finite, a zero normal, a negative variance).")
+      .def(
+          "insert_free",
+          [](Surface& s, const ArrayD& points, double value, double variance) {
+            const std::vector<Vec3d> p = points_from(points, "points");
+            py::array_t<std::int64_t> ids(static_cast<py::ssize_t>(p.size()));
+            std::int64_t* out = ids.mutable_data();
+            py::gil_scoped_release release;
+            const auto lock = write_lock(&s);
+            for (std::size_t i = 0; i < p.size(); ++i) {
+              const auto id = s.insert_free(p[i], value, variance);
+              out[i] = id ? static_cast<std::int64_t>(*id) : -1;
+            }
+            return ids;
+          },
+          py::arg("points"), py::arg("value"), py::arg("variance"),
+          "Adds (N, 3) free-space points, each observing the field's value `value` (> 0: "
+          "outside) with noise variance `variance`. Returns their ids, -1 where refused.")
+      .def(
+          "update",
+          [](Surface& s, std::size_t id, const ArrayD& point, const ArrayD& normal,
+             double variance) {
+            const Vec3d p = vec3(point, "point"), n = vec3(normal, "normal");
+            py::gil_scoped_release release;
+            const auto lock = write_lock(&s);
+            try {
+              return s.update(id, p, n, variance);
+            } catch (const std::out_of_range& e) {
+              throw py::index_error(e.what());
+            }
+          },
+          py::arg("id"), py::arg("point"), py::arg("normal"), py::arg("variance") = 0.0,
+          "Moves surface point `id` (a fused point that moved); False, and nothing changed, "
+          "for an invalid input or a free-space point; IndexError for an unknown id.")
+      .def(
+          "erase",
+          [](Surface& s, std::size_t id) {
+            py::gil_scoped_release release;
+            const auto lock = write_lock(&s);
+            try {
+              s.erase(id);
+            } catch (const std::out_of_range& e) {
+              throw py::index_error(e.what());
+            }
+          },
+          py::arg("id"), "Removes point `id`; IndexError for an unknown or erased id.")
+      .def(
+          "set_prior",
+          [](Surface& s, const ArrayD& centre, double radius) {
+            const Vec3d c = vec3(centre, "centre");
+            py::gil_scoped_release release;
+            const auto lock = write_lock(&s);
+            try {
+              s.set_prior(c, radius);
+            } catch (const std::invalid_argument& e) {
+              throw py::value_error(e.what());
+            }
+          },
+          py::arg("centre"), py::arg("radius"),
+          "Replaces the prior sphere; ValueError for a non-finite centre or a negative radius.")
+      .def(
+          "predict",
+          [](const Surface& s, const ArrayD& points) {
+            const std::vector<Vec3d> p = points_from(points, "points");
+            const auto n = static_cast<py::ssize_t>(p.size());
+            ArrayD mean(n), var(n), grad({n, py::ssize_t{3}});
+            double* mo = mean.mutable_data();
+            double* vo = var.mutable_data();
+            double* go = grad.mutable_data();
+            {
+              py::gil_scoped_release release;
+              const auto lock = read_lock(&s);
+              Eigen::Matrix3Xd q(3, n);
+              for (py::ssize_t i = 0; i < n; ++i) q.col(i) = p[static_cast<std::size_t>(i)];
+              s.evaluate(q, mo, vo);
+              for (py::ssize_t i = 0; i < n; ++i) {
+                Vec3d g = Vec3d::Zero();
+                (void)s.mean(p[static_cast<std::size_t>(i)], g);
+                store(go + 3 * i, g);
+              }
+            }
+            return py::make_tuple(mean, var, grad);
+          },
+          py::arg("points"),
+          "The field at (N, 3) points: (mean (N,), variance (N,), gradient of the mean (N, 3)).")
+      .def(
+          "mean",
+          [](const Surface& s, const ArrayD& points) {
+            const std::vector<Vec3d> p = points_from(points, "points");
+            const auto n = static_cast<py::ssize_t>(p.size());
+            ArrayD mean(n);
+            double* mo = mean.mutable_data();
+            py::gil_scoped_release release;
+            const auto lock = read_lock(&s);
+            for (py::ssize_t i = 0; i < n; ++i) mo[i] = s.mean(p[static_cast<std::size_t>(i)]);
+            return mean;
+          },
+          py::arg("points"), "The posterior mean of the field at (N, 3) points, (N,).")
+      .def(
+          "mesh",
+          [](const Surface& s, const ArrayD& lo, const ArrayD& hi, double spacing) {
+            const sh::Grid g = grid_from(lo, hi, spacing);
+            sh::SurfaceMesh mesh;
+            {
+              py::gil_scoped_release release;
+              const auto lock = read_lock(&s);
+              mesh = sh::extract_surface(s, g);
+            }
+            return mesh_dict(mesh);
+          },
+          py::arg("lo"), py::arg("hi"), py::arg("spacing"),
+          "The zero level set of the mean on a grid of `spacing` over the box [lo, hi], closed "
+          "at the box: a dict with vertices (V, 3), triangles (T, 3) uint32 (counter-clockwise "
+          "seen from outside), sigma (V,) [m] and normals (V, 3).")
+      .def(
+          "score_touches",
+          [](const Surface& s, const ArrayD& origins, const ArrayD& directions,
+             const ArrayD& targets, const ArrayD& lo, const ArrayD& hi, double spacing,
+             double max_distance, double noise_sigma, double radius, int patch_points,
+             double patch_radius, double target_spacing) {
+            const std::vector<Vec3d> o = points_from(origins, "origins");
+            const std::vector<Vec3d> d = points_from(directions, "directions");
+            if (o.size() != d.size())
+              throw py::value_error("score_touches: origins and directions differ in length");
+            const std::vector<Vec3d> t = points_from(targets, "targets");
+            const sh::Grid g = grid_from(lo, hi, spacing);
+            std::vector<sh::TouchCandidate> cands(o.size());
+            for (std::size_t i = 0; i < o.size(); ++i) cands[i] = {o[i], d[i], max_distance};
+            std::vector<sh::TouchPrediction> r;
+            try {
+              py::gil_scoped_release release;
+              const auto lock = read_lock(&s);
+              r = sh::score_touches(
+                  s, g, s.sample(g), t, cands,
+                  {noise_sigma, radius, patch_points, patch_radius, target_spacing});
+            } catch (const std::invalid_argument& e) {
+              throw py::value_error(e.what());
+            }
+            const auto n = static_cast<py::ssize_t>(r.size());
+            py::array_t<bool> contact(n);
+            ArrayD point({n, py::ssize_t{3}}), normal({n, py::ssize_t{3}}), gain(n);
+            for (py::ssize_t i = 0; i < n; ++i) {
+              const auto& x = r[static_cast<std::size_t>(i)];
+              contact.mutable_data()[i] = x.contact;
+              store(point.mutable_data() + 3 * i, x.point);
+              store(normal.mutable_data() + 3 * i, x.normal);
+              gain.mutable_data()[i] = x.gain;
+            }
+            py::dict out;
+            out["contact"] = contact;
+            out["point"] = point;
+            out["normal"] = normal;
+            out["gain"] = gain;
+            return out;
+          },
+          py::arg("origins"), py::arg("directions"), py::arg("targets"), py::arg("lo"),
+          py::arg("hi"), py::kw_only(), py::arg("spacing") = 3e-3, py::arg("max_distance") = 0.5,
+          py::arg("noise_sigma") = 0.3e-3, py::arg("radius") = 0.012, py::arg("patch_points") = 4,
+          py::arg("patch_radius") = 3e-3, py::arg("target_spacing") = 4e-3,
+          "Predicts and scores candidate touches, approach rays from (N, 3) origins along (N, 3) "
+          "directions: each contact is where the ray first crosses the mean's zero level "
+          "(sampled at `spacing` over [lo, hi]); its gain the expected drop of the variance "
+          "summed over the (M, 3) targets within `radius` of it. A dict with contact (N,) bool, "
+          "point (N, 3), normal (N, 3) and gain (N,) [m^2].");
+
+  m.def(
+      "approach_rays",
+      [](const ArrayD& centre, double standoff, double aim_radius, int count, std::uint64_t seed) {
+        const Vec3d c = vec3(centre, "centre");
+        std::mt19937_64 rng(seed);
+        std::vector<sh::TouchCandidate> r;
+        try {
+          r = sh::approach_rays(c, standoff, aim_radius, count, rng);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+        std::vector<Vec3d> o, d;
+        for (const auto& x : r) {
+          o.push_back(x.origin);
+          d.push_back(x.direction);
+        }
+        return py::make_tuple(points_array(o), points_array(d));
+      },
+      py::arg("centre"), py::arg("standoff"), py::arg("aim_radius"), py::arg("count"),
+      py::kw_only(), py::arg("seed") = 1,
+      "`count` random approach rays: (origins (N, 3), unit directions (N, 3)), each from the "
+      "sphere of radius `standoff` around `centre` towards a random point within `aim_radius` "
+      "of it. Deterministic for a seed.");
+
+  m.def(
+      "marching_tetrahedra",
+      [](const py::array_t<double, py::array::f_style | py::array::forcecast>& values,
+         const ArrayD& origin, double spacing, double level, bool close) {
+        if (values.ndim() != 3)
+          throw py::value_error("marching_tetrahedra: values must be a 3-D array (nx, ny, nz)");
+        sh::Grid g;
+        g.origin = vec3(origin, "origin");
+        g.spacing = spacing;
+        g.nodes = {static_cast<int>(values.shape(0)), static_cast<int>(values.shape(1)),
+                   static_cast<int>(values.shape(2))};
+        std::vector<double> v(values.data(), values.data() + values.size());
+        sh::Mesh mesh;
+        try {
+          py::gil_scoped_release release;
+          mesh = sh::marching_tetrahedra(g, v, level, close);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+        py::array_t<std::uint32_t> tri(
+            {static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
+        if (!mesh.triangles.empty())
+          std::memcpy(tri.mutable_data(), mesh.triangles.data(), mesh.triangles.size() * 3 * 4);
+        return py::make_tuple(points_array(mesh.vertices), tri);
+      },
+      py::arg("values"), py::arg("origin"), py::arg("spacing"), py::kw_only(),
+      py::arg("level") = 0.0, py::arg("close") = false,
+      "The surface where a field sampled on a grid, values[i, j, k] at origin + spacing * (i, "
+      "j, k), crosses `level`, by marching tetrahedra: (vertices (V, 3), triangles (T, 3) "
+      "uint32), counter-clockwise seen from above the level. `close` counts the grid's border "
+      "as above the level, closing the mesh.");
+}
+
+}  // namespace taxel::python
