@@ -133,6 +133,14 @@ class GaussianProcess {
     return mean<true>(x, gradient);
   }
 
+  /// sum_i w_i k(|x - x_i|) for weights w (size() of them): the posterior mean when w = K^-1 y.
+  /// O(n), no allocation.
+  [[nodiscard]] double weighted_sum(const Vec3d& x,
+                                    const Eigen::Ref<const Eigen::VectorXd>& w) const {
+    Vec3d unused = Vec3d::Zero();
+    return weighted_sum<false>(x, w.data(), unused);
+  }
+
   /// Posterior mean, variance and gradient at `x`. O(n^2) (a triangular solve).
   [[nodiscard]] FieldPrediction predict(const Vec3d& x) const {
     FieldPrediction out;
@@ -189,6 +197,14 @@ class GaussianProcess {
     if (n > 0) L_.topLeftCorner(n, n).triangularView<Eigen::Lower>().solveInPlace(m);
   }
 
+  /// Replaces each column b of `m` (size() rows) by L^-T b (after solve_lower: K^-1 b).
+  template <class M>
+  void solve_upper(M& m) const {
+    const auto n = static_cast<Eigen::Index>(n_);
+    if (n > 0)
+      L_.topLeftCorner(n, n).transpose().template triangularView<Eigen::Upper>().solveInPlace(m);
+  }
+
   /// The prior covariances k(|x_i - x|) of `x` with every observation.
   [[nodiscard]] Eigen::VectorXd covariances(const Vec3d& x) const {
     if (n_ == 0) return Eigen::VectorXd();
@@ -200,6 +216,10 @@ class GaussianProcess {
   // one exponential per observation.
   template <bool Gradient>
   double mean(const Vec3d& x, Vec3d& gradient) const {
+    return weighted_sum<Gradient>(x, alpha_.data(), gradient);
+  }
+  template <bool Gradient>
+  double weighted_sum(const Vec3d& x, const double* weights, Vec3d& gradient) const {
     using Block = Eigen::Array<double, Eigen::Dynamic, 1, 0, 256, 1>;
     const auto n = static_cast<Eigen::Index>(n_);
     double out = 0.0;
@@ -212,7 +232,7 @@ class GaussianProcess {
       dz = x[2] - x_.col(2).segment(first, c).array();
       r = (dx.square() + dy.square() + dz.square()).sqrt();
       kernel_.evaluate(r, k, s);
-      const auto a = alpha_.segment(first, c).array();
+      const auto a = Eigen::Map<const Eigen::ArrayXd>(weights + first, c);
       out += (k * a).sum();
       if constexpr (Gradient) {
         // d k(|x - x_i|) / dx = k'(r) / r (x - x_i)

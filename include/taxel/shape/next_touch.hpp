@@ -23,7 +23,6 @@
 #include <random>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -53,7 +52,7 @@ struct TouchPrediction {
 struct ScoringConfig {
   double noise_sigma = 0.3e-3;  ///< sigma: noise of each predicted observation, > 0
   double radius = 0.012;        ///< targets farther from the contact do not count, > 0
-  int patch_points = 4;         ///< points on the circle around the contact, in [0, 64]
+  int patch_points = 0;         ///< points on the circle around the contact, in [0, 64]
   double patch_radius = 3e-3;   ///< the circle's radius, >= 0
   /// The targets are thinned to the first in each cube of this side (a mesh's vertices are
   /// far denser than the variance changes); 0 keeps them all. Finite and >= 0.
@@ -179,13 +178,6 @@ template <Kernel K>
   if (targets.empty()) return out;
   const index::KdTree<double> tree(targets);
   const double noise = config.noise_sigma * config.noise_sigma;
-  // Per expert: the whitened targets it needs, computed once (a multi-column solve).
-  struct Cache {
-    Eigen::MatrixXd whitened;  // n x ids
-    std::unordered_map<std::uint32_t, Eigen::Index> column;
-  };
-  std::unordered_map<std::uint64_t, Cache> caches;
-  const double L = surface.config().expert_size;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const TouchCandidate& cand = candidates[c];
     if (!cand.origin.allFinite() || !cand.direction.allFinite() || !(cand.direction.norm() > 0.0))
@@ -215,42 +207,29 @@ template <Kernel K>
       continue;
     }
     const GaussianProcess<K>& gp = e->process;
-    auto [it, fresh] = caches.try_emplace(ImplicitSurface<K>::cell_key(cell));
-    Cache& cache = it->second;
-    if (fresh) {
-      // Every target a contact in this expert's cell can reach.
-      const Vec3d centre = L * (Vec3d(cell[0], cell[1], cell[2]) + Vec3d::Constant(0.5));
-      const auto reach = tree.within(centre, std::sqrt(3.0) * 0.5 * L + config.radius);
-      Eigen::Matrix3Xd q(3, static_cast<Eigen::Index>(reach.size()));
-      for (std::size_t i = 0; i < reach.size(); ++i) {
-        cache.column[reach[i].id] = static_cast<Eigen::Index>(i);
-        q.col(static_cast<Eigen::Index>(i)) = targets[reach[i].id];
-      }
-      cache.whitened = gp.cross_covariances(q);
-      gp.solve_lower(cache.whitened);
-    }
-    // gain(q) = c' S^-1 c with c = k(q, O) - W_O' w_q.
+    // gain(q) = c' S^-1 c with c = k(q, O) - W_O' w_q = k(q, O) - U' k(X, q), U = K^-1 k(X, O)
+    // = L^-T W_O: two triangular solves per touch, none per target.
     const auto m = static_cast<Eigen::Index>(patch.size());
-    Eigen::MatrixXd wo(static_cast<Eigen::Index>(gp.size()), m);
-    for (Eigen::Index i = 0; i < m; ++i) wo.col(i) = gp.whiten(patch[static_cast<std::size_t>(i)]);
-    Eigen::MatrixXd s(m, m);
+    Eigen::Matrix3Xd o(3, m);
+    for (Eigen::Index i = 0; i < m; ++i) o.col(i) = patch[static_cast<std::size_t>(i)];
+    Eigen::MatrixXd wo(static_cast<Eigen::Index>(gp.size()), m), u(wo.rows(), m);
     for (Eigen::Index i = 0; i < m; ++i) {
-      for (Eigen::Index j = 0; j < m; ++j) {
-        s(i, j) = surface.kernel()(
-            (patch[static_cast<std::size_t>(i)] - patch[static_cast<std::size_t>(j)]).norm());
-      }
+      Eigen::VectorXd v = gp.whiten(o.col(i));  // one triangular solve per column: no packing
+      wo.col(i) = v;
+      gp.solve_upper(v);
+      u.col(i) = v;
     }
+    Eigen::MatrixXd s(m, m);
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (Eigen::Index j = 0; j < m; ++j) s(i, j) = surface.kernel()((o.col(i) - o.col(j)).norm());
     s.noalias() -= wo.transpose() * wo;
     s.diagonal().array() += noise;
     const Eigen::LLT<Eigen::MatrixXd> llt(s);
     Eigen::VectorXd cq(m);
     for (const auto& nb : near) {
-      const auto col = cache.column.find(static_cast<std::uint32_t>(nb.id));
-      if (col == cache.column.end()) continue;  // cannot happen: the reach covers the radius
       const Vec3d& q = targets[nb.id];
       for (Eigen::Index i = 0; i < m; ++i)
-        cq(i) = surface.kernel()((q - patch[static_cast<std::size_t>(i)]).norm());
-      cq.noalias() -= wo.transpose() * cache.whitened.col(col->second);
+        cq(i) = surface.kernel()((q - o.col(i)).norm()) - gp.weighted_sum(q, u.col(i));
       p.gain += cq.dot(llt.solve(cq));
     }
   }
