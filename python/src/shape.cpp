@@ -340,7 +340,7 @@ surface's variance. Lengths in metres.)doc");
           },
           py::arg("origins"), py::arg("directions"), py::arg("targets"), py::arg("lo"),
           py::arg("hi"), py::kw_only(), py::arg("spacing") = 3e-3, py::arg("max_distance") = 0.5,
-          py::arg("noise_sigma") = 0.3e-3, py::arg("radius") = 0.012, py::arg("patch_points") = 4,
+          py::arg("noise_sigma") = 0.3e-3, py::arg("radius") = 0.012, py::arg("patch_points") = 0,
           py::arg("patch_radius") = 3e-3, py::arg("target_spacing") = 4e-3,
           "Predicts and scores candidate touches, approach rays from (N, 3) origins along (N, 3) "
           "directions: each contact is where the ray first crosses the mean's zero level "
