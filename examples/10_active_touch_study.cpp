@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
     st.seed = jobs[j].seed;
     runs[j] = std::visit(
         [&](const auto& sh) {
-          return taxel_explore::explore(sh, st,
+          return taxel_explore::explore(taxel_explore::AnyShape::of(sh), st,
                                         [](taxel_explore::TouchRecord& r) { r.estimate = {}; });
         },
         shapes[jobs[j].shape].shape);
@@ -116,8 +116,8 @@ int main(int argc, char** argv) {
   appendf(text, "Surface error (symmetric RMS, mm) after %d touches, and the touch at which the\n",
           touches);
   appendf(text, "active policy first reaches the random policy's final error:\n\n");
-  appendf(text, "%-10s %4s %10s %10s %10s %9s %9s\n", "shape", "seed", "random_mm", "active_mm",
-          "reached_at", "rand_cov", "act_cov");
+  appendf(text, "%-10s %4s %10s %10s %10s %10s %10s %9s %9s\n", "shape", "seed", "random_mm",
+          "rand_sgn", "active_mm", "act_sgn", "reached_at", "rand_cov", "act_cov");
   std::vector<int> at;
   int never = 0;
   for (std::size_t j = 0; j < jobs.size(); j += 2) {
@@ -127,10 +127,11 @@ int main(int argc, char** argv) {
     const int k = reached(act, target);
     if (k == 0) ++never;
     at.push_back(k == 0 ? touches + 1 : k);
-    appendf(text, "%-10s %4llu %10.3f %10.3f %10s %9.3f %9.3f\n",
+    appendf(text, "%-10s %4llu %10.3f %+10.3f %10.3f %+10.3f %10s %9.3f %9.3f\n",
             shapes[jobs[j].shape].name.c_str(), static_cast<unsigned long long>(jobs[j].seed),
-            1e3 * target, 1e3 * act.back().surface_rms,
-            k == 0 ? "never" : std::to_string(k).c_str(), rnd.back().coverage, act.back().coverage);
+            1e3 * target, 1e3 * rnd.back().surface_signed, 1e3 * act.back().surface_rms,
+            1e3 * act.back().surface_signed, k == 0 ? "never" : std::to_string(k).c_str(),
+            rnd.back().coverage, act.back().coverage);
   }
   std::vector<int> sorted = at;
   std::sort(sorted.begin(), sorted.end());
@@ -169,7 +170,7 @@ int main(int argc, char** argv) {
     st.library = &library;
     rruns[j] = std::visit(
         [&](const auto& sh) {
-          return taxel_explore::explore(sh, st,
+          return taxel_explore::explore(taxel_explore::AnyShape::of(sh), st,
                                         [](taxel_explore::TouchRecord& r) { r.estimate = {}; });
         },
         models[rjobs[j].shape].shape);

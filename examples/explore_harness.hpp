@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -53,6 +56,8 @@ struct TouchRecord {
   std::size_t contacts = 0;  ///< contacts so far
   std::size_t points = 0;    ///< fused points so far
   double surface_rms = 0.0;  ///< symmetric RMS distance estimate <-> truth [m]
+  /// mean signed distance of the estimate's samples to the true surface [m], > 0 outside
+  double surface_signed = 0.0;
   double coverage = 0.0;     ///< share of the true surface within coverage_radius of a point
   double mean_std = 0.0;     ///< area-weighted mean posterior standard deviation [m]
   std::string top1;          ///< most probable model (with a library; empty before 6 points)
@@ -91,40 +96,75 @@ inline std::vector<Vec3d> sample_mesh(const taxel::shape::Mesh& mesh, std::size_
   return out;
 }
 
+struct SurfaceError {
+  double rms = std::numeric_limits<double>::infinity();
+  double signed_mean = 0.0;
+};
+
 // Symmetric RMS distance between the estimate and the true surface: estimate samples to the
-// truth (exact signed distance) and truth samples to the estimate (closest point on its mesh).
+// truth (exact signed distance) and truth samples to the estimate (closest point on its mesh);
+// and the mean signed distance of the estimate's samples (> 0: outside the object).
 template <class World>
-double surface_rms(const World& world, const taxel::shape::Mesh& mesh,
-                   const std::vector<Vec3d>& truth, std::mt19937_64& rng) {
+SurfaceError surface_error(const World& world, const taxel::shape::Mesh& mesh,
+                           const std::vector<Vec3d>& truth, std::mt19937_64& rng) {
   std::vector<Vec3d> v = mesh.vertices;
   std::vector<taxel::sim::TriangleMesh::Triangle> tris;
   for (const auto& t : mesh.triangles) {
     if ((v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]).norm() > 1e-16) tris.push_back(t);
   }
-  if (tris.empty()) return std::numeric_limits<double>::infinity();
+  if (tris.empty()) return {};
   const taxel::sim::TriangleMesh estimate(std::move(v), std::move(tris));
-  double sum = 0.0;
+  double sum = 0.0, sum_signed = 0.0;
   std::size_t n = 0;
   for (const Vec3d& p : sample_mesh(mesh, truth.size(), rng)) {
     const double d = world.signed_distance(p);
     sum += d * d;
+    sum_signed += d;
     ++n;
   }
+  const double estimate_samples = double(n);
   for (const Vec3d& p : truth) {
     const double d = (estimate.closest_point(p) - p).norm();
     sum += d * d;
     ++n;
   }
-  return std::sqrt(sum / double(n));
+  return {std::sqrt(sum / double(n)), sum_signed / estimate_samples};
 }
 
 }  // namespace detail
 
+/// Any simulated shape behind one interface, so that the exploration loop is compiled once for
+/// all of them (a template per shape type took most of the tools' build time).
+struct AnyShape {
+  std::function<double(const Vec3d&)> distance;
+  std::function<Vec3d(const Vec3d&)> closest, outward;
+  std::function<void(std::mt19937_64&, Vec3d&, Vec3d&)> draw;
+
+  /// Wraps `shape` (copied).
+  template <taxel::sim::SampleableShape Sh>
+  static AnyShape of(Sh shape) {
+    const auto s = std::make_shared<const Sh>(std::move(shape));
+    return {[s](const Vec3d& p) { return s->signed_distance(p); },
+            [s](const Vec3d& p) { return Vec3d(s->closest_point(p)); },
+            [s](const Vec3d& p) { return Vec3d(s->normal(p)); },
+            [s](std::mt19937_64& rng, Vec3d& p, Vec3d& n) { sample_point(*s, rng, p, n); }};
+  }
+  double signed_distance(const Vec3d& p) const { return distance(p); }
+  Vec3d closest_point(const Vec3d& p) const { return closest(p); }
+  Vec3d normal(const Vec3d& p) const { return outward(p); }
+};
+
+/// A uniform surface point of `s` with its outward normal.
+inline void sample_point(const AnyShape& s, std::mt19937_64& rng, Vec3d& p, Vec3d& n) {
+  s.draw(rng, p, n);
+}
+
 /// Explores `shape` (in its own frame) placed at a random pose drawn from the seed, and
-/// records the estimate after every touch (`keep_meshes`: with its mesh). `on_touch` is called
-/// after each touch with its record (e.g. to write its mesh and drop it).
-template <taxel::sim::SampleableShape Sh, class OnTouch>
-std::vector<TouchRecord> explore(const Sh& shape, Settings s, OnTouch&& on_touch) {
+/// records the estimate after every touch. `on_touch` is called after each touch with its
+/// record (e.g. to write its mesh and drop it).
+inline std::vector<TouchRecord> explore(const AnyShape& shape, Settings s,
+                                        const std::function<void(TouchRecord&)>& on_touch) {
+  using Sh = AnyShape;
   namespace ts = taxel::sim;
   namespace tsh = taxel::shape;
   if (s.touches < 1 || s.candidates < 1)
@@ -210,7 +250,10 @@ std::vector<TouchRecord> explore(const Sh& shape, Settings s, OnTouch&& on_touch
     r.points = explorer.cloud().size();
     r.estimate = explorer.estimate();
     r.mean_std = r.estimate.mean_sigma();
-    r.surface_rms = detail::surface_rms(world, r.estimate.mesh, truth.points, metric_rng);
+    const detail::SurfaceError err =
+        detail::surface_error(world, r.estimate.mesh, truth.points, metric_rng);
+    r.surface_rms = err.rms;
+    r.surface_signed = err.signed_mean;
     if (r.points > 0) {
       std::vector<Vec3d> fused;
       for (std::size_t i = 0; i < explorer.cloud().size(); ++i)

@@ -778,16 +778,17 @@ void active_touch_section(bool quick, const fs::path& out, Page& page) {
   taxel_explore::TouchRecord last;
   std::vector<std::vector<std::string>> rows;
   const sim::Box box(Vec3d(0.04, 0.03, 0.02));
-  (void)taxel_explore::explore(box, st, [&](taxel_explore::TouchRecord& r) {
-    rows.push_back({std::to_string(r.touch), std::to_string(r.contacts),
-                    fmt("%.2f", 1e3 * r.surface_rms), fmt("%.0f %%", 100.0 * r.coverage),
-                    fmt("%.2f", 1e3 * r.mean_std)});
-    figures["active_touch"].push_back({{"touch", r.touch},
-                                       {"surface_rms_m", r.surface_rms},
-                                       {"coverage", r.coverage},
-                                       {"mean_std_m", r.mean_std}});
-    last = r;
-  });
+  (void)taxel_explore::explore(
+      taxel_explore::AnyShape::of(box), st, [&](taxel_explore::TouchRecord& r) {
+        rows.push_back({std::to_string(r.touch), std::to_string(r.contacts),
+                        fmt("%.2f", 1e3 * r.surface_rms), fmt("%.0f %%", 100.0 * r.coverage),
+                        fmt("%.2f", 1e3 * r.mean_std)});
+        figures["active_touch"].push_back({{"touch", r.touch},
+                                           {"surface_rms_m", r.surface_rms},
+                                           {"coverage", r.coverage},
+                                           {"mean_std_m", r.mean_std}});
+        last = r;
+      });
   const shape::SurfaceMesh& est = last.estimate;
   io::write_ply((out / "active_touch_estimate.ply").string(), est.to_point_cloud(),
                 io::PlyFormat::binary_little_endian, est.mesh.triangles);

@@ -36,7 +36,8 @@ its face tangent to the surface and lets go. Its contacts are fused (Surfel) int
 Gaussian-process implicit surface with local experts (Matern 3/2 kernel), meshed every touch.
 
 Per touch: the contacts so far; surface_rms, the symmetric RMS distance between the estimate's
-mesh and the true surface (both ways) [m]; coverage, the share of the true surface within
+mesh and the true surface (both ways) [m]; surface_signed, the mean signed distance of the
+estimate to the true surface [m] (> 0: the estimate lies outside); coverage, the share of the true surface within
 --coverage-radius of a fused point; mean_std, the estimate's posterior standard deviation
 averaged over its area [m]. With --library, also top1 (the most probable model's file name
 without .ply) and its probability.
@@ -92,8 +93,7 @@ std::vector<double> numbers(const taxel_cli::Args& args, std::string_view text) 
   return v;
 }
 
-template <class Shape>
-int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
+int run(const Options& o, const taxel_explore::AnyShape& shape, const taxel_cli::Args& args) {
   std::vector<std::pair<std::string, std::string>> meshes;
   std::vector<taxel_explore::TouchRecord> records;
   try {
@@ -126,6 +126,7 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
     taxel_cli::Json row = {{"touch", r.touch},
                            {"contacts", r.contacts},
                            {"surface_rms", r.surface_rms},
+                           {"surface_signed", r.surface_signed},
                            {"coverage", r.coverage},
                            {"mean_std", r.mean_std}};
     if (recognise) {
@@ -141,13 +142,13 @@ int run(const Options& o, const Shape& shape, const taxel_cli::Args& args) {
     text = taxel_cli::render(rows, o.format);
   } else {
     char line[256];
-    std::snprintf(line, sizeof line, "%5s %8s %14s %8s %11s%s\n", "touch", "contacts",
-                  "surface_rms_mm", "coverage", "mean_std_mm",
+    std::snprintf(line, sizeof line, "%5s %8s %14s %17s %8s %11s%s\n", "touch", "contacts",
+                  "surface_rms_mm", "surface_signed_mm", "coverage", "mean_std_mm",
                   recognise ? "  top1 (probability)" : "");
     text = line;
     for (const auto& r : records) {
-      std::snprintf(line, sizeof line, "%5d %8zu %14.3f %8.3f %11.3f", r.touch, r.contacts,
-                    1e3 * r.surface_rms, r.coverage, 1e3 * r.mean_std);
+      std::snprintf(line, sizeof line, "%5d %8zu %14.3f %+17.3f %8.3f %11.3f", r.touch, r.contacts,
+                    1e3 * r.surface_rms, 1e3 * r.surface_signed, r.coverage, 1e3 * r.mean_std);
       text += line;
       if (recognise) {
         std::snprintf(line, sizeof line, "  %s (%.3f)", r.top1.empty() ? "-" : r.top1.c_str(),
@@ -263,27 +264,29 @@ int main(int argc, char** argv) {
       } catch (const std::invalid_argument& e) {
         args.fail(taxel_cli::input_name(o.mesh) + ": " + e.what(), 1);
       }
-      return run(o, *mesh, args);
+      return run(o, taxel_explore::AnyShape::of(std::move(*mesh)), args);
     }
-    if (o.shape == "sphere") return run(o, ts::Sphere(dims(1, {0.03})[0]), args);
+    if (o.shape == "sphere")
+      return run(o, taxel_explore::AnyShape::of(ts::Sphere(dims(1, {0.03})[0])), args);
     if (o.shape == "cylinder") {
       const auto d = dims(2, {0.025, 0.04});
-      return run(o, ts::Cylinder(d[0], d[1]), args);
+      return run(o, taxel_explore::AnyShape::of(ts::Cylinder(d[0], d[1])), args);
     }
     if (o.shape == "box") {
       const auto d = dims(3, {0.04, 0.03, 0.02});
-      return run(o, ts::Box(taxel::Vec3d(d[0], d[1], d[2])), args);
+      return run(o, taxel_explore::AnyShape::of(ts::Box(taxel::Vec3d(d[0], d[1], d[2]))), args);
     }
     if (o.shape == "cone") {
       const auto d = dims(2, {0.03, 0.06});
-      return run(o, ts::Cone(d[0], d[1]), args);
+      return run(o, taxel_explore::AnyShape::of(ts::Cone(d[0], d[1])), args);
     }
     if (o.shape == "ellipsoid") {
       const auto d = dims(3, {0.045, 0.035, 0.025});
-      return run(o, ts::Ellipsoid(taxel::Vec3d(d[0], d[1], d[2])), args);
+      return run(o, taxel_explore::AnyShape::of(ts::Ellipsoid(taxel::Vec3d(d[0], d[1], d[2]))),
+                 args);
     }
     const auto d = dims(2, {0.035, 0.012});
-    return run(o, ts::Torus(d[0], d[1]), args);
+    return run(o, taxel_explore::AnyShape::of(ts::Torus(d[0], d[1])), args);
   } catch (const std::invalid_argument& e) {
     args.fail(e.what());
   }

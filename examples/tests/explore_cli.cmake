@@ -36,9 +36,9 @@ endforeach()
 
 # The same seed gives the same table; CSV and text carry the same columns.
 run_tool("${TOOL}" 0 --shape box --touches 2 --seed 3 --format csv --policy random)
-expect("${out}" "^touch,contacts,surface_rms,coverage,mean_std\n1,")
+expect("${out}" "^touch,contacts,surface_rms,surface_signed,coverage,mean_std\n1,")
 run_tool("${TOOL}" 0 --shape sphere --touches 2 --policy scripted)
-expect("${out}" "touch contacts +surface_rms_mm +coverage +mean_std_mm\n +1 ")
+expect("${out}" "touch contacts +surface_rms_mm +surface_signed_mm +coverage +mean_std_mm\n +1 ")
 
 # Recognition among three models (the true surfaces taxel-simulate samples).
 file(MAKE_DIRECTORY "${WORK_DIR}/lib")
