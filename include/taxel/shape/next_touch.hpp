@@ -6,9 +6,9 @@
 // planner for recovering the shape of novel objects", IJHR 2018), touches go where the surface
 // is least certain. A touch observes the field (value 0) at its contact and at
 // `patch_points` points on a circle of `patch_radius` around it in the predicted tangent plane,
-// each with noise sigma^2. With the expert e nearest the contact, whose posterior covariance is
-// C(a, b) = k(|a - b|) - v(a)' v(b) (GaussianProcess::whiten), those observations O lower the
-// variance at a target point q by
+// each with noise sigma^2. With the expert e whose cell holds the contact, whose posterior
+// covariance is C(a, b) = k(|a - b|) - v(a)' v(b) (GaussianProcess::whiten), those
+// observations O lower the variance at a target point q by
 //   gain(q) = c' S^-1 c,   c = C(q, O),   S = C(O, O) + sigma^2 I,
 // which does not depend on the values observed, so it is exact before touching. The score is
 // the sum of gain(q) over the targets q (e.g. the estimated surface's vertices) within `radius`
