@@ -646,3 +646,22 @@ TEST_CASE("confidence_region: with no touch, the prior sphere widened by k prior
   CHECK(radii(region.outer, r + k * sf) <= 3 * h * h / 8 / (r + k * sf - std::sqrt(3.0) * h));
   CHECK_THROWS_WITH(sh::confidence_region(surface, grid, 0.0), Catch::Contains("k must be"));
 }
+
+TEST_CASE("score_touches: with no observations the gain is the prior's closed form",
+          "[shape][touch]") {
+  // One observation at the contact o against the prior: gain(q) = k(q, o)^2 / (k(0) + s^2).
+  sh::ImplicitSurface surface({.prior_radius = 0.02});
+  const sh::Grid grid = sh::Grid::covering(Vec3d::Constant(-0.04), Vec3d::Constant(0.04), 0.002);
+  const std::vector<Vec3d> targets{{0.0, 0.003, 0.02}, {0.004, 0.0, 0.0195}, {0.0, 0.0, 0.02}};
+  const sh::ScoringConfig cfg{.target_spacing = 0.0};
+  const auto r = sh::score_touches(surface, grid, surface.sample(grid), targets,
+                                   {{Vec3d(0, 0, 0.1), Vec3d(0, 0, -1), 1.0}}, cfg);
+  REQUIRE(r[0].contact);
+  const auto& k = surface.kernel();
+  double want = 0.0;
+  for (const Vec3d& q : targets) {
+    const double c = k((q - r[0].point).norm());
+    want += c * c / (k.variance() + cfg.noise_sigma * cfg.noise_sigma);
+  }
+  CHECK(r[0].gain == Approx(want).epsilon(1e-12));
+}

@@ -191,13 +191,7 @@ class GaussianProcess {
     return Eigen::Map<const Eigen::MatrixXd>(k.data(), X.cols(), points.cols());
   }
 
-  /// Replaces each column b of `m` (size() rows) by L^-1 b.
-  void solve_lower(Eigen::MatrixXd& m) const {
-    const auto n = static_cast<Eigen::Index>(n_);
-    if (n > 0) L_.topLeftCorner(n, n).triangularView<Eigen::Lower>().solveInPlace(m);
-  }
-
-  /// Replaces each column b of `m` (size() rows) by L^-T b (after solve_lower: K^-1 b).
+  /// Replaces each column b of `m` (size() rows) by L^-T b (applied to whiten(x): K^-1 k(X, x)).
   template <class M>
   void solve_upper(M& m) const {
     const auto n = static_cast<Eigen::Index>(n_);

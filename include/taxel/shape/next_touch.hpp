@@ -118,33 +118,6 @@ template <class = void>
   return out;
 }
 
-/// Expected reduction of the variance at each of `targets` when the observations at `at`
-/// (noise variance `noise`) join process `gp` (the file comment's gain(q), exact).
-template <Kernel K>
-[[nodiscard]] Eigen::VectorXd variance_reduction(const GaussianProcess<K>& gp,
-                                                 const std::vector<Vec3d>& at, double noise,
-                                                 const Eigen::Matrix3Xd& targets) {
-  const auto m = static_cast<Eigen::Index>(at.size());
-  Eigen::Matrix3Xd o(3, m);
-  for (Eigen::Index i = 0; i < m; ++i) o.col(i) = at[static_cast<std::size_t>(i)];
-  Eigen::MatrixXd wo(static_cast<Eigen::Index>(gp.size()), m);
-  for (Eigen::Index i = 0; i < m; ++i) wo.col(i) = gp.whiten(o.col(i));
-  Eigen::MatrixXd s(m, m);
-  for (Eigen::Index i = 0; i < m; ++i)
-    for (Eigen::Index j = 0; j < m; ++j) s(i, j) = gp.kernel()((o.col(i) - o.col(j)).norm());
-  if (gp.size() > 0) s -= wo.transpose() * wo;
-  s.diagonal().array() += noise;
-  const Eigen::LLT<Eigen::MatrixXd> llt(s);
-  Eigen::VectorXd out(targets.cols());
-  for (Eigen::Index q = 0; q < targets.cols(); ++q) {
-    Eigen::VectorXd c(m);
-    for (Eigen::Index i = 0; i < m; ++i) c(i) = gp.kernel()((targets.col(q) - o.col(i)).norm());
-    if (gp.size() > 0) c -= wo.transpose() * gp.whiten(targets.col(q));
-    out(q) = c.dot(llt.solve(c));
-  }
-  return out;
-}
-
 /// Predicts and scores every candidate touch (see the file comment) on `surface`, whose
 /// posterior mean is `field` on `grid` (ImplicitSurface::sample). The targets, the points whose
 /// uncertainty counts, are `all_targets` thinned by config.target_spacing. Throws
@@ -197,16 +170,9 @@ template <Kernel K>
     if (near.empty()) continue;
     const CellIndex cell = surface.nearest_expert(p.point);
     const auto* e = surface.find(cell);
-    if (e == nullptr || e->process.size() == 0) {
-      // No observations: the prior, whose variance reduction needs no whitening.
-      GaussianProcess<K> prior(surface.kernel());
-      Eigen::Matrix3Xd q(3, static_cast<Eigen::Index>(near.size()));
-      for (std::size_t i = 0; i < near.size(); ++i)
-        q.col(static_cast<Eigen::Index>(i)) = targets[near[i].id];
-      p.gain = variance_reduction(prior, patch, noise, q).sum();
-      continue;
-    }
-    const GaussianProcess<K>& gp = e->process;
+    // An expert with no observations is the prior: the same formula with n = 0.
+    const GaussianProcess<K> prior(surface.kernel());
+    const GaussianProcess<K>& gp = e != nullptr ? e->process : prior;
     // gain(q) = c' S^-1 c with c = k(q, O) - W_O' w_q = k(q, O) - U' k(X, q), U = K^-1 k(X, O)
     // = L^-T W_O: two triangular solves per touch, none per target.
     const auto m = static_cast<Eigen::Index>(patch.size());
