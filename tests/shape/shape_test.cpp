@@ -109,6 +109,58 @@ TEST_CASE("Matern kernels: slopes are k'(r) / r by finite differences", "[shape]
                     Catch::Contains("sigma must be finite and > 0"));
 }
 
+#if TAXEL_SHAPE_LANES
+TEMPLATE_TEST_CASE("lanes: the SIMD kernel sums equal plain sums with std::exp", "[shape][kernel]",
+                   sh::Matern32, sh::Matern52) {
+  namespace ln = sh::detail::lanes;
+  // The exponential alone, over its whole range and beyond the clamp.
+  for (const double x :
+       {0.0, -1e-12, -0.3465, -0.3466, -1.0, -5.5, -37.0, -699.0, -700.0, -745.0, -1e6}) {
+    ln::D2 v = ln::D2{} + x, e;
+    ln::exp_nonpositive(v, e);
+    const double expected = std::exp(std::max(x, -700.0));
+    CHECK(std::abs(e[0] - expected) <= 1e-15 * expected);
+  }
+  // Sums of every length from 0 to 11 (all remainders of both widths), queries on an
+  // observation (r = 0), near and far.
+  const TestType kernel({.length_scale = 0.02, .sigma = 0.01});
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  for (std::size_t n = 0; n <= 11; ++n) {
+    std::vector<double> xs(n), ys(n), zs(n), w(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      xs[i] = u(rng);
+      ys[i] = u(rng);
+      zs[i] = u(rng);
+      w[i] = 1e3 * u(rng);
+    }
+    const double* p[3] = {xs.data(), ys.data(), zs.data()};
+    std::vector<Vec3d> queries{Vec3d(0.001, -0.002, 0.003), Vec3d(2.0, 0.0, -1.0)};
+    if (n > 0) queries.emplace_back(xs[0], ys[0], zs[0]);
+    for (const Vec3d& q : queries) {
+      double sum = 0.0, scale = 0.0;
+      Vec3d grad = Vec3d::Zero();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3d d = q - Vec3d(xs[i], ys[i], zs[i]);
+        sum += w[i] * kernel(d.norm());
+        grad += w[i] * kernel.slope(d.norm()) * d;
+        scale += std::abs(w[i]) * kernel.variance();
+      }
+      std::vector<double (*)(const TestType&, std::size_t, const double* const*, const double*,
+                             const double*, double*)>
+          paths{&ln::kernel_sum_sse2<true, TestType>};
+      if (ln::cpu_has_avx2_fma()) paths.push_back(&ln::kernel_sum_avx2<true, TestType>);
+      for (const auto path : paths) {
+        Vec3d g = Vec3d::Constant(NAN);
+        const double got = path(kernel, n, p, q.data(), w.data(), g.data());
+        CHECK(std::abs(got - sum) <= 1e-14 * scale);
+        CHECK((g - grad).norm() <= 1e-13 * scale / 0.02);
+      }
+    }
+  }
+}
+#endif
+
 TEST_CASE("GaussianProcess: mean and variance equal scikit-learn's", "[shape][gp]") {
   check_against_sklearn<sh::Matern32>(kMean32, kStd32);
   check_against_sklearn<sh::Matern52>(kMean52, kStd52);

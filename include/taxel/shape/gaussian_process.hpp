@@ -214,6 +214,13 @@ class GaussianProcess {
   }
   template <bool Gradient>
   double weighted_sum(const Vec3d& x, const double* weights, Vec3d& gradient) const {
+#if TAXEL_SHAPE_LANES
+    if constexpr (detail::lanes::LaneKernel<K>) {
+      const double* p[3] = {x_.col(0).data(), x_.col(1).data(), x_.col(2).data()};
+      return detail::lanes::kernel_sum<Gradient>(kernel_, n_, p, x.data(), weights,
+                                                 gradient.data());
+    }
+#endif
     using Block = Eigen::Array<double, Eigen::Dynamic, 1, 0, 256, 1>;
     const auto n = static_cast<Eigen::Index>(n_);
     double out = 0.0;

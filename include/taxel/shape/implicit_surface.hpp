@@ -265,12 +265,17 @@ class ImplicitSurface {
     return out;
   }
 
-  /// Posterior means, and variances when `variance` is not null, at the columns of `points`:
-  /// the points are grouped by cell, and each of a cell's 8 experts predicts the whole group
-  /// through one kernel matrix (and one multi-column triangular solve for the variances).
+  /// Posterior means, and variances when `variance` is not null, at the columns of `points`.
+  /// Means alone are point by point (the kernel sums run on SIMD lanes); with variances the
+  /// points are grouped by cell, and each expert around a cell predicts the group's points
+  /// that blend it through one kernel matrix and one multi-column triangular solve.
   void evaluate(const Eigen::Ref<const Eigen::Matrix3Xd>& points, double* mean,
                 double* variance) const {
     const Eigen::Index total = points.cols();
+    if (variance == nullptr) {
+      for (Eigen::Index q = 0; q < total; ++q) mean[q] = this->mean(Vec3d(points.col(q)));
+      return;
+    }
     // Grouped by cell; each of the 27 experts around a cell predicts, in one batch, the
     // group's points that blend it.
     std::vector<std::pair<std::uint64_t, Eigen::Index>> order(static_cast<std::size_t>(total));

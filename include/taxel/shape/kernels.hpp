@@ -14,6 +14,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "taxel/shape/lanes.hpp"
+
 namespace taxel::shape {
 
 /// A stationary isotropic covariance k(r): `operator()(r)` its value, `slope(r)` the derivative
@@ -84,6 +86,16 @@ struct Matern32 {
     k = s2_ * (1.0 + a_ * r) * slope;
     slope *= -s2_ * a_ * a_;
   }
+#if TAXEL_SHAPE_LANES
+  /// evaluate() on SIMD lanes of distances (shape/lanes.hpp).
+  template <class V>
+  [[gnu::always_inline]] void evaluate_lanes(const V& r, V& k, V& slope) const {
+    const V ar = a_ * r;
+    detail::lanes::exp_nonpositive(V{} - ar, slope);
+    k = s2_ * (1.0 + ar) * slope;
+    slope *= -s2_ * a_ * a_;
+  }
+#endif
   /// k(0) = s^2.
   [[nodiscard]] double variance() const noexcept { return s2_; }
   /// The settings.
@@ -132,6 +144,16 @@ struct Matern52 {
     k = s2_ * (1.0 + a_ * r + (a_ * a_ / 3.0) * r.square()) * slope;
     slope *= -s2_ * a_ * a_ / 3.0 * (1.0 + a_ * r);
   }
+#if TAXEL_SHAPE_LANES
+  /// evaluate() on SIMD lanes of distances (shape/lanes.hpp).
+  template <class V>
+  [[gnu::always_inline]] void evaluate_lanes(const V& r, V& k, V& slope) const {
+    const V ar = a_ * r;
+    detail::lanes::exp_nonpositive(V{} - ar, slope);
+    k = s2_ * (1.0 + ar + ar * ar / 3.0) * slope;
+    slope *= -s2_ * a_ * a_ / 3.0 * (1.0 + ar);
+  }
+#endif
   /// k(0) = s^2.
   [[nodiscard]] double variance() const noexcept { return s2_; }
   /// The settings.
