@@ -26,12 +26,13 @@ ArrayD vec_array(const Vec3d& v) {
   return out;
 }
 
-Surface make_surface(double expert_size, double normal_offset, double blend, double min_sigma,
-                     const std::optional<ArrayD>& prior_centre, double prior_radius,
-                     double length_scale, double sigma) {
+Surface make_surface(double expert_size, double normal_offset, double inside_offset, double blend,
+                     double min_sigma, const std::optional<ArrayD>& prior_centre,
+                     double prior_radius, double length_scale, double sigma) {
   sh::SurfaceConfig c;
   c.expert_size = expert_size;
   c.normal_offset = normal_offset;
+  c.inside_offset = inside_offset;
   c.blend = blend;
   c.min_sigma = min_sigma;
   c.prior_centre = prior_centre ? vec3(*prior_centre, "prior_centre") : Vec3d::Zero();
@@ -67,8 +68,9 @@ py::dict mesh_dict(const sh::SurfaceMesh& m) {
 constexpr const char* kSurfaceDoc = R"doc(
 A Gaussian-process implicit surface over local experts: a field f, negative inside, zero on
 the surface, positive outside, about the signed distance near it, with a posterior variance
-everywhere. Each surface point observes f = 0 there and f = +-d at +-d along its normal
-(d = normal_offset); free-space points observe a positive value. The prior mean is the signed
+everywhere. Each surface point observes f = 0 there, f = d at d along its normal and
+f = -d_in at d_in against it (d = normal_offset, d_in = inside_offset; 0 leaves one out);
+free-space points observe a positive value. The prior mean is the signed
 distance to the sphere (prior_centre, prior_radius); the kernel is Matern 3/2 with length_scale
 and sigma (scikit-learn's ConstantKernel(sigma**2) * Matern(length_scale, nu=1.5)). Experts of
 side expert_size each keep an exact process of the points within half a side of their cube;
@@ -103,17 +105,20 @@ surface's variance. Lengths in metres.)doc");
           alive[i] = p.alive;
           free[i] = p.free;
         }
-        return py::make_tuple(c.expert_size, c.normal_offset, c.blend, c.min_sigma,
-                              vec_array(c.prior_centre), c.prior_radius,
-                              s.kernel().config().length_scale, s.kernel().config().sigma,
-                              points_array(pos), points_array(nor), vector_array(var),
-                              vector_array(val), vector_array(alive), vector_array(free));
+        return py::make_tuple(
+            c.expert_size, c.normal_offset, c.blend, c.min_sigma, vec_array(c.prior_centre),
+            c.prior_radius, s.kernel().config().length_scale, s.kernel().config().sigma,
+            points_array(pos), points_array(nor), vector_array(var), vector_array(val),
+            vector_array(alive), vector_array(free), c.inside_offset);
       },
       [](const py::tuple& a) {
-        if (a.size() != 14) throw py::value_error("ImplicitSurface: damaged pickled state");
-        Surface s = make_surface(a[0].cast<double>(), a[1].cast<double>(), a[2].cast<double>(),
-                                 a[3].cast<double>(), a[4].cast<ArrayD>(), a[5].cast<double>(),
-                                 a[6].cast<double>(), a[7].cast<double>());
+        // 14 items: pickled before inside_offset existed, when it was normal_offset.
+        if (a.size() != 14 && a.size() != 15)
+          throw py::value_error("ImplicitSurface: damaged pickled state");
+        const double inside = a.size() == 15 ? a[14].cast<double>() : a[1].cast<double>();
+        Surface s = make_surface(a[0].cast<double>(), a[1].cast<double>(), inside,
+                                 a[2].cast<double>(), a[3].cast<double>(), a[4].cast<ArrayD>(),
+                                 a[5].cast<double>(), a[6].cast<double>(), a[7].cast<double>());
         const std::vector<Vec3d> pos = points_from(a[8].cast<ArrayD>(), "positions");
         const std::vector<Vec3d> nor = points_from(a[9].cast<ArrayD>(), "normals");
         const auto var = a[10].cast<std::vector<double>>();
@@ -134,7 +139,8 @@ surface's variance. Lengths in metres.)doc");
         return s;
       });
   cls.def(py::init(&make_surface), py::kw_only(), py::arg("expert_size") = 0.015,
-          py::arg("normal_offset") = 0.003, py::arg("blend") = 0.1, py::arg("min_sigma") = 0.2e-3,
+          py::arg("normal_offset") = 0.003, py::arg("inside_offset") = 0.003,
+          py::arg("blend") = 0.1, py::arg("min_sigma") = 0.2e-3,
           py::arg("prior_centre") = py::none(), py::arg("prior_radius") = 0.0,
           py::arg("length_scale") = 0.02, py::arg("sigma") = 0.01,
           "An empty surface (prior_centre None: the origin); ValueError naming a setting out "

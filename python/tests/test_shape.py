@@ -29,7 +29,7 @@ def test_matches_scikit_learn_where_one_expert_holds_every_point():
     normals = rng.normal(size=(10, 3))
     var = rng.uniform(1e-8, 4e-7, size=10)
     centre, radius = np.array([0.004, 0.006, 0.005]), 0.003
-    s = shape.ImplicitSurface(expert_size=L, normal_offset=0.0, min_sigma=1e-6, prior_centre=centre,
+    s = shape.ImplicitSurface(expert_size=L, normal_offset=0.0, inside_offset=0.0, min_sigma=1e-6, prior_centre=centre,
                               prior_radius=radius, length_scale=0.012, sigma=0.008)
     assert (s.insert(x, normals, var) >= 0).all()
     prior = lambda p: np.linalg.norm(p - centre, axis=1) - radius  # noqa: E731

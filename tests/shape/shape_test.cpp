@@ -289,6 +289,7 @@ TEST_CASE("ImplicitSurface: experts equal the exact process when they hold every
   const double L = 0.02;
   sh::SurfaceConfig cfg{.expert_size = L,
                         .normal_offset = 0.002,
+                        .inside_offset = 0.0015,
                         .min_sigma = 1e-4,
                         .prior_centre = Vec3d(0.01, 0.01, 0.0),
                         .prior_radius = 0.004};
@@ -306,9 +307,9 @@ TEST_CASE("ImplicitSurface: experts equal the exact process when they hold every
     const double var = (i % 3) * 1e-8;
     REQUIRE(surface.insert(p, n, var));
     const double nv = std::max(var, 1e-8);
-    for (const double s : {0.0, 1.0, -1.0}) {
-      const Vec3d x = p + s * cfg.normal_offset * n;
-      REQUIRE(exact.add(x, s * cfg.normal_offset - surface.prior(x), nv));
+    for (const double s : {0.0, cfg.normal_offset, -cfg.inside_offset}) {
+      const Vec3d x = p + s * n;
+      REQUIRE(exact.add(x, s - surface.prior(x), nv));
     }
   }
   CHECK(surface.expert_count() == 8);
@@ -589,6 +590,28 @@ TEST_CASE("score_touches: the gain equals a brute-force refit", "[shape][touch]"
                     Catch::Contains("noise_sigma"));
   CHECK_THROWS_WITH(sh::score_touches(surface, grid, std::vector<double>(3), targets, cands),
                     Catch::Contains("does not fit"));
+}
+
+TEST_CASE("ImplicitSurface: the outside and inside offsets place their observations",
+          "[shape][surface]") {
+  const Vec3d p(0.004, 0.003, 0.002), n = Vec3d(1.0, 2.0, 2.0) / 3.0;
+  for (const auto& [out, in] : {std::pair{0.003, 0.001}, std::pair{0.002, 0.0},
+                                std::pair{0.0, 0.0015}, std::pair{0.0, 0.0}}) {
+    sh::ImplicitSurface surface(
+        {.expert_size = 0.01, .normal_offset = out, .inside_offset = in, .min_sigma = 1e-7});
+    REQUIRE(surface.insert(p, n, 0.0));
+    const std::size_t per_point = 1 + (out > 0.0) + (in > 0.0);
+    surface.for_each_expert(p, [&](const auto* e, double, const Vec3d&) {
+      REQUIRE(e != nullptr);
+      CHECK(e->process.size() == per_point);
+    });
+    // Each observation is all but noise-free, so the mean passes through it.
+    CHECK(surface.mean(p) == Approx(0.0).margin(1e-9));
+    if (out > 0.0) CHECK(surface.mean(Vec3d(p + out * n)) == Approx(out).margin(1e-9));
+    if (in > 0.0) CHECK(surface.mean(Vec3d(p - in * n)) == Approx(-in).margin(1e-9));
+  }
+  CHECK_THROWS_WITH(sh::ImplicitSurface({.inside_offset = -1e-3}),
+                    Catch::Contains("inside_offset must be finite and >= 0"));
 }
 
 TEST_CASE("ImplicitSurface: free-space points observe the field's value", "[shape][surface]") {

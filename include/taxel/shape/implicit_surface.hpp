@@ -4,7 +4,8 @@
 // ICRA 2011): a field f over space, negative inside the object, zero on its surface, positive
 // outside, about the signed distance near the surface. Each surface point p with outward normal
 // n and variance s^2 along n gives three observations: f(p) = 0, f(p + d n) = d and
-// f(p - d n) = -d (d the normal offset), each with noise variance s^2.
+// f(p - d_in n) = -d_in (d and d_in the outside and inside offsets), each with noise
+// variance s^2.
 //
 // The prior mean is the signed distance to a sphere, m(x) = |x - c| - r (Martens et al.,
 // "Geometric priors for Gaussian process implicit surfaces", IEEE RA-L 2017), so that the
@@ -52,9 +53,12 @@ struct SurfaceConfig {
   /// L: spacing of the experts; each holds the points within L of it along every axis, so its
   /// size grows with L^2 of touched surface. Finite and > 0.
   double expert_size = 0.015;
-  /// d: the off-surface observations' distance along the normal; 0 leaves them out (the
-  /// normals then go unused). Finite and >= 0.
+  /// d: the outside observation's distance along the normal; 0 leaves it out. Finite and >= 0.
   double normal_offset = 0.003;
+  /// d_in: the inside observation's distance against the normal; 0 leaves it out (with both
+  /// 0 the normals go unused). Finite and >= 0. Near an edge the point d_in inside lies closer
+  /// than d_in to the next face, so -d_in overstates its depth and pushes the surface out there.
+  double inside_offset = 0.003;
   /// b: half-width of the band around a cell face where a query blends the experts on both
   /// sides, as a fraction of expert_size. In (0, 0.5].
   double blend = 0.1;
@@ -76,6 +80,8 @@ struct SurfaceConfig {
     if (!(blend > 0.0) || !(blend <= 0.5)) bad("blend", blend, "in (0, 0.5]");
     if (!(normal_offset >= 0.0) || !std::isfinite(normal_offset))
       bad("normal_offset", normal_offset, "finite and >= 0 [m]");
+    if (!(inside_offset >= 0.0) || !std::isfinite(inside_offset))
+      bad("inside_offset", inside_offset, "finite and >= 0 [m]");
     if (!(min_sigma > 0.0) || !std::isfinite(min_sigma))
       bad("min_sigma", min_sigma, "finite and > 0 [m]");
     if (!prior_centre.allFinite())
@@ -424,7 +430,7 @@ class ImplicitSurface {
       case 1:
         return {p.position + d * p.normal, d};
       case 2:
-        return {p.position - d * p.normal, -d};
+        return {p.position - config_.inside_offset * p.normal, -config_.inside_offset};
       default:
         return {p.position, 0.0};
     }
@@ -535,13 +541,17 @@ class ImplicitSurface {
     if (!all_changed_ && std::find(changed_.begin(), changed_.end(), k) == changed_.end())
       changed_.push_back(k);
   }
-  int kinds() const { return config_.normal_offset > 0.0 ? 3 : 1; }
+  bool has_kind(int kind) const {
+    return kind == 0 || (kind == 1 && config_.normal_offset > 0.0) ||
+           (kind == 2 && config_.inside_offset > 0.0);
+  }
   void attach(std::size_t id) {
     const CellIndex base = lower_holder(points_[id].position);
     const double nv = noise(id);
     for (int c = 0; c < 8; ++c) {
       Expert& e = expert({base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + ((c >> 2) & 1)});
-      for (int kind = 0; kind < kinds(); ++kind) {
+      for (int kind = 0; kind < 3; ++kind) {
+        if (!has_kind(kind)) continue;
         const std::uint64_t owner =
             std::uint64_t(id) * 4 + std::uint64_t(points_[id].free ? 3 : kind);
         if (points_[id].free && kind > 0) break;
