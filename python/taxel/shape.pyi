@@ -33,17 +33,66 @@ class TouchScores(typing.TypedDict):
     gain: numpy.typing.NDArray[numpy.float64]
 
 
+class Explorer:
+    """The loop of exploring an object by touch: contacts are fused (Surfel over VoxelHash), the fused
+points feed an implicit surface (see ImplicitSurface; its settings here have the same names),
+whose mean is sampled on a grid of `grid_spacing` over the workspace box. estimate() meshes it
+with each vertex's standard deviation; score() predicts candidate touches (approach rays) on it
+and scores them by the expected drop of the surface's variance over the estimate's vertices
+within `radius` of each contact. With fit_prior_radius the prior sphere's radius follows the
+points' mean distance from prior_centre. add_free_space() tells it where a finger moved without
+touching. Lengths in metres. Calls from several threads run one at a time and release the GIL.
+Pickles whole: fused cloud, surface and settings."""
+    def __init__(self, *, workspace_min: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, workspace_max: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, grid_spacing: float = 0.002, expert_size: float = 0.015, normal_offset: float = 0.003, inside_offset: float = 0.003, min_sigma: float = 0.0002, prior_centre: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, prior_radius: float = 0.0, fit_prior_radius: bool = True, length_scale: float = 0.02, sigma: float = 0.01, noise_sigma: float = 0.0003, radius: float = 0.012, target_spacing: float = 0.004, free_spacing: float = 0.005, free_threshold: float = 0.005, free_cap: float = 0.003) -> None: """An explorer with nothing touched yet; the workspace box defaults to +-60 mm around the origin. ValueError naming a setting out of range."""
+    def __len__(self) -> int: ...
+    def __repr__(self) -> str: ...
+    @typing.overload
+    def add_contacts(self, positions: numpy.typing.NDArray[numpy.float64], covariances: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, normals: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, *, sigma: typing.Optional[float] = None) -> int: ...
+    @typing.overload
+    def add_contacts(self, contacts: taxel.Contacts) -> int: ...
+    def add_free_space(self, start: numpy.typing.NDArray[numpy.float64], end: numpy.typing.NDArray[numpy.float64]) -> int: """Tells the surface that the segment from `start` to `end` is free (a finger moved through it); points every free_spacing where the estimate puts the surface near or beyond them observe a positive field. Returns how many were added."""
+    def estimate(self) -> taxel.shape.SurfaceMesh: """The estimated surface: a dict with vertices (V, 3), triangles (T, 3) uint32, sigma (V,) [m] and normals (V, 3) (see ImplicitSurface.mesh)."""
+    def field(self) -> numpy.typing.NDArray[numpy.float64]: """The posterior mean on the grid, (nx, ny, nz): entry [i, j, k] at grid_origin + grid_spacing * (i, j, k) (marching_tetrahedra's layout)."""
+    @property
+    def grid_origin(self) -> numpy.typing.NDArray[numpy.float64]: ...
+    @property
+    def grid_spacing(self) -> float: ...
+    @property
+    def points(self) -> numpy.typing.NDArray[numpy.float64]: ...
+    def predict(self, points: numpy.typing.NDArray[numpy.float64]) -> typing.Tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]: """The surface's field at (N, 3) points: (mean (N,), variance (N,))."""
+    @property
+    def prior_radius(self) -> float: ...
+    def score(self, origins: numpy.typing.NDArray[numpy.float64], directions: numpy.typing.NDArray[numpy.float64], *, max_distance: float = 0.5) -> taxel.shape.TouchScores: """Predicts and scores candidate touches, approach rays from (N, 3) origins along (N, 3) directions up to max_distance: a dict with contact (N,) bool, point (N, 3), normal (N, 3) and gain (N,) [m^2] (see ImplicitSurface.score_touches). The best touch is the contact with the largest gain."""
+
+
+class Hypothesis:
+    """One hypothesis of a recognition belief: a model at a pose."""
+    def __init__(self, *, name: str, model: int, model_from_world: numpy.typing.NDArray[numpy.float64], score: float = 0.0, probability: float) -> None: """A hypothesis; ValueError unless model_from_world is a rigid (4, 4) transform."""
+    def __repr__(self) -> str: ...
+    @property
+    def model(self) -> int: ...
+    @property
+    def model_from_world(self) -> numpy.typing.NDArray[numpy.float64]: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def probability(self) -> float: ...
+    @property
+    def score(self) -> float: ...
+
+
 class ImplicitSurface:
     """A Gaussian-process implicit surface over local experts: a field f, negative inside, zero on
 the surface, positive outside, about the signed distance near it, with a posterior variance
-everywhere. Each surface point observes f = 0 there and f = +-d at +-d along its normal
-(d = normal_offset); free-space points observe a positive value. The prior mean is the signed
+everywhere. Each surface point observes f = 0 there, f = d at d along its normal and
+f = -d_in at d_in against it (d = normal_offset, d_in = inside_offset; 0 leaves one out);
+free-space points observe a positive value. The prior mean is the signed
 distance to the sphere (prior_centre, prior_radius); the kernel is Matern 3/2 with length_scale
 and sigma (scikit-learn's ConstantKernel(sigma**2) * Matern(length_scale, nu=1.5)). Experts of
 side expert_size each keep an exact process of the points within half a side of their cube;
 adding or moving a point updates 8 of them by rank-one steps, never a refit. Lengths in metres.
 Calls from several threads run one at a time (queries together) and release the GIL."""
-    def __init__(self, *, expert_size: float = 0.015, normal_offset: float = 0.003, blend: float = 0.1, min_sigma: float = 0.0002, prior_centre: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, prior_radius: float = 0.0, length_scale: float = 0.02, sigma: float = 0.01) -> None: """An empty surface (prior_centre None: the origin); ValueError naming a setting out of range."""
+    def __init__(self, *, expert_size: float = 0.015, normal_offset: float = 0.003, inside_offset: float = 0.003, blend: float = 0.1, min_sigma: float = 0.0002, prior_centre: typing.Optional[numpy.typing.NDArray[numpy.float64]] = None, prior_radius: float = 0.0, length_scale: float = 0.02, sigma: float = 0.01) -> None: """An empty surface (prior_centre None: the origin); ValueError naming a setting out of range."""
     def __len__(self) -> int: ...
     def __repr__(self) -> str: ...
     def erase(self, id: int) -> None: """Removes point `id`; IndexError for an unknown or erased id."""
@@ -64,4 +113,8 @@ Calls from several threads run one at a time (queries together) and release the 
 
 def approach_rays(centre: numpy.typing.NDArray[numpy.float64], standoff: float, aim_radius: float, count: int, *, seed: int = 1) -> typing.Tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]: """`count` random approach rays: (origins (N, 3), unit directions (N, 3)), each from the sphere of radius `standoff` around `centre` towards a random point within `aim_radius` of it. Deterministic for a seed."""
 
+def hypotheses(recognition: taxel.registration.ObjectRecognition, points: int, *, sigma: float = 0.001, max_points: int = 50) -> typing.List[taxel.shape.Hypothesis]: """The belief over (model, pose) of an ObjectLibrary.recognize() result for a cloud of `points` points, most probable first: p ~ exp(-n score^2 / (2 sigma^2)), n = min(points, max_points). Empty for a failed recognition."""
+
 def marching_tetrahedra(values: numpy.typing.NDArray[numpy.float64], origin: numpy.typing.NDArray[numpy.float64], spacing: float, *, level: float = 0.0, close: bool = False) -> typing.Tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.uint32]]: """The surface where a field sampled on a grid, values[i, j, k] at origin + spacing * (i, j, k), crosses `level`, by marching tetrahedra: (vertices (V, 3), triangles (T, 3) uint32), counter-clockwise seen from above the level. `close` counts the grid's border as above the level, closing the mesh."""
+
+def score_recognition_touches(library: taxel.registration.ObjectLibrary, belief: typing.List[taxel.shape.Hypothesis], origins: numpy.typing.NDArray[numpy.float64], directions: numpy.typing.NDArray[numpy.float64], *, max_distance: float = 0.5, ray_sigma: float = 0.002, surface_tolerance: float = 0.0015, confusion: float = 0.001, hypotheses: int = 6) -> numpy.typing.NDArray[numpy.float64]: """The expected drop of the belief's entropy [nats] for each candidate touch (approach rays from (N, 3) origins along (N, 3) directions), over its `hypotheses` most probable entries: each ray is cast against each model at its pose, and a touch scores high when the likely models disagree on where (or whether) it meets the object."""

@@ -29,8 +29,9 @@ def test_matches_scikit_learn_where_one_expert_holds_every_point():
     normals = rng.normal(size=(10, 3))
     var = rng.uniform(1e-8, 4e-7, size=10)
     centre, radius = np.array([0.004, 0.006, 0.005]), 0.003
-    s = shape.ImplicitSurface(expert_size=L, normal_offset=0.0, inside_offset=0.0, min_sigma=1e-6, prior_centre=centre,
-                              prior_radius=radius, length_scale=0.012, sigma=0.008)
+    s = shape.ImplicitSurface(expert_size=L, normal_offset=0.0, inside_offset=0.0, min_sigma=1e-6,
+                              prior_centre=centre, prior_radius=radius, length_scale=0.012,
+                              sigma=0.008)
     assert (s.insert(x, normals, var) >= 0).all()
     prior = lambda p: np.linalg.norm(p - centre, axis=1) - radius  # noqa: E731
     gp = sklearn.GaussianProcessRegressor(
@@ -168,3 +169,166 @@ def test_bad_input_is_refused_clearly():
         s.score_touches(np.zeros((1, 3)), np.ones((1, 3)), np.zeros((1, 3)), [-1] * 3, [1] * 3,
                         spacing=0.1, noise_sigma=0.0)
     assert taxel.shape is shape
+
+
+def _cap(centre_dir, n, r=0.03, half_angle=0.35, seed=0):
+    """n contacts on a cap of a sphere of radius r around unit direction centre_dir."""
+    rng = np.random.default_rng(seed)
+    d = np.asarray(centre_dir, float) / np.linalg.norm(centre_dir)
+    u = d + half_angle * rng.normal(size=(n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return r * u, u
+
+
+def test_explorer_fuses_touches_and_scores_the_untouched_side():
+    ex = shape.Explorer(workspace_min=[-0.045] * 3, workspace_max=[0.045] * 3, grid_spacing=3e-3)
+    assert len(ex) == 0 and "Explorer(0 fused points" in repr(ex)
+    added = 0
+    for k, d in enumerate([(1, 0, 0), (0, 1, 0), (0, 0, 1), (-1, 0, 0), (0, -1, 0)]):
+        p, n = _cap(d, 300, seed=k)
+        added += ex.add_contacts(p, normals=n, sigma=2e-4)
+    assert added >= len(ex) and 0 < len(ex) <= 1500  # added or moved
+    assert ex.points.shape == (len(ex), 3)
+    assert abs(ex.prior_radius - 0.03) < 2e-3  # refitted to the points' mean distance
+    est = ex.estimate()
+    r = np.linalg.norm(est["vertices"], axis=1)
+    assert est["triangles"].dtype == np.uint32 and len(est["triangles"]) > 0
+    # Where touched (+x), the estimate lies on the sphere, and is surer than on the -z side.
+    touched = est["vertices"][:, 0] > 0.025
+    assert np.abs(r[touched] - 0.03).max() < 1e-3
+    untouched = est["vertices"][:, 2] < -0.025
+    assert est["sigma"][touched].mean() < 0.5 * est["sigma"][untouched].mean()
+    field = ex.field()
+    assert field.shape == (31, 31, 31) and np.isclose(ex.grid_spacing, 3e-3)
+    # The field sampled on the grid is the surface's mean there.
+    node = ex.grid_origin + ex.grid_spacing * np.array([20, 15, 15])
+    mean, var = ex.predict(node[None])
+    assert abs(field[20, 15, 15] - mean[0]) < 1e-12 and var[0] >= 0
+    # Two rays at the centre, from +x (touched) and from -z (not): -z teaches more.
+    origins = np.array([[0.07, 0, 0], [0, 0, -0.07]])
+    scores = ex.score(origins, -origins / 0.07)
+    assert scores["contact"].all()
+    assert scores["gain"][1] > 2 * scores["gain"][0]
+    np.testing.assert_allclose(np.linalg.norm(scores["point"], axis=1), 0.03, atol=1.5e-3)
+    # Free space along a ray that passes the sphere.
+    assert ex.add_free_space([0.07, 0.0, 0.04], [-0.07, 0.0, 0.04]) >= 0
+
+
+def test_explorer_pickles_and_copies_whole():
+    ex = shape.Explorer(workspace_min=[-0.045] * 3, workspace_max=[0.045] * 3, grid_spacing=3e-3,
+                        inside_offset=0.002)
+    for k, d in enumerate([(1, 0, 0), (0, 1, 0), (0, 0, 1)]):
+        p, n = _cap(d, 200, seed=k)
+        ex.add_contacts(p, normals=n, sigma=2e-4)
+    ex.add_free_space([0.07, 0.0, 0.04], [-0.07, 0.0, 0.04])
+    for twin in (pickle.loads(pickle.dumps(ex)), copy.deepcopy(ex)):
+        assert len(twin) == len(ex) and twin.prior_radius == ex.prior_radius
+        np.testing.assert_array_equal(twin.points, ex.points)
+        np.testing.assert_allclose(twin.field(), ex.field(), atol=1e-12)
+        a, b = twin.estimate(), ex.estimate()
+        np.testing.assert_allclose(a["vertices"], b["vertices"], atol=1e-9)
+        np.testing.assert_allclose(a["sigma"], b["sigma"], atol=1e-9)
+        # And they go on alike.
+        p, n = _cap((-1, 0, 0), 200, seed=9)
+        assert twin.add_contacts(p, normals=n, sigma=2e-4) > 0
+    ex.add_contacts(p, normals=n, sigma=2e-4)
+    assert len(twin) == len(ex)
+    np.testing.assert_allclose(twin.field(), ex.field(), atol=1e-12)
+    state = ex.__getstate__()
+    broken = (state[0], (state[1][0], state[1][1], state[1][2], state[1][3], state[1][4],
+                         state[1][5][:-1]))
+    with pytest.raises(ValueError, match="surface ids"):
+        shape.Explorer.__new__(shape.Explorer).__setstate__(broken)
+
+
+def test_explorer_refuses_bad_input():
+    with pytest.raises(ValueError, match="grid_spacing|spacing"):
+        shape.Explorer(grid_spacing=0.0)
+    with pytest.raises(ValueError, match="2\\^27 grid nodes"):
+        shape.Explorer(workspace_min=[-10.0] * 3, workspace_max=[10.0] * 3, grid_spacing=1e-3)
+    with pytest.raises(ValueError, match="inside_offset"):
+        shape.Explorer(inside_offset=-1.0)
+    ex = shape.Explorer()
+    p = np.array([[0.0, 0.0, 0.03], [np.nan, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="contact 1"):
+        ex.add_contacts(p, sigma=1e-3)
+    assert len(ex) == 0  # nothing was added
+    with pytest.raises(ValueError, match="differ in length"):
+        ex.score(np.zeros((2, 3)), np.ones((3, 3)))
+    with pytest.raises(ValueError, match="max_distance"):
+        ex.score(np.zeros((1, 3)), np.ones((1, 3)), max_distance=-1.0)
+
+
+def test_explorer_threads_add_and_score_together():
+    ex = shape.Explorer(workspace_min=[-0.045] * 3, workspace_max=[0.045] * 3, grid_spacing=3e-3)
+    errors = []
+
+    def add(k):
+        try:
+            p, n = _cap([(1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, -1)][k], 200, seed=k)
+            ex.add_contacts(p, normals=n, sigma=2e-4)
+            ex.estimate()
+            ex.score(np.array([[0.07, 0.0, 0.0]]), np.array([[-1.0, 0.0, 0.0]]))
+        except Exception as e:  # noqa: BLE001
+            errors.append(e)
+
+    threads = [threading.Thread(target=add, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    # The same contacts one after another give the same fused cloud size.
+    one = shape.Explorer(workspace_min=[-0.045] * 3, workspace_max=[0.045] * 3, grid_spacing=3e-3)
+    for k in range(4):
+        p, n = _cap([(1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, -1)][k], 200, seed=k)
+        one.add_contacts(p, normals=n, sigma=2e-4)
+    assert abs(len(one) - len(ex)) <= 0.02 * len(one)  # order changes which contacts merge
+
+
+def _ball(r, n=2000, seed=0):
+    p, _ = _sphere_points(n, r, seed)
+    return p
+
+
+def _brick(a, b, c, n=3000, seed=0):
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(-1, 1, size=(n, 3)) * [a, b, c]
+    axis = rng.integers(0, 3, size=n)
+    p[np.arange(n), axis] = np.sign(rng.uniform(-1, 1, n)) * np.array([a, b, c])[axis]
+    return p
+
+
+def test_recognition_belief_and_touch_scores():
+    lib = taxel.registration.ObjectLibrary()
+    lib.add("ball", _ball(0.03))
+    lib.add("brick", _brick(0.04, 0.03, 0.02))
+    cloud = _ball(0.03, 400, seed=5)
+    cloud = cloud[cloud[:, 2] > 0.01]  # a cap: the ball explains it, the brick does not
+    belief = shape.hypotheses(lib.recognize(cloud), len(cloud))
+    assert [h.name for h in belief][0] == "ball"
+    assert abs(sum(h.probability for h in belief) - 1.0) < 1e-12
+    assert belief[0].model_from_world.shape == (4, 4)
+    h2 = pickle.loads(pickle.dumps(belief[0]))
+    assert h2.name == "ball" and h2.probability == belief[0].probability
+    # Two equally likely hypotheses, both at the identity: a ray at 33 mm from the centre along
+    # +z meets the ball (within tolerance) and misses the brick; one through the centre meets
+    # both at 10 mm apart.
+    eq = [shape.Hypothesis(name="ball", model=0, model_from_world=np.eye(4), probability=0.5),
+          shape.Hypothesis(name="brick", model=1, model_from_world=np.eye(4), probability=0.5)]
+    origins = np.array([[-0.1, 0.0, 0.028], [-0.1, 0.0, 0.0], [-0.1, 0.0, 0.2]])
+    dirs = np.array([[1.0, 0, 0]] * 3)
+    gain = shape.score_recognition_touches(lib, eq, origins, dirs, confusion=1e-3)
+    # Hit against miss: each outcome leaves p = (1, c) / (1 + c): gain = ln 2 - H(1 / (1 + c)).
+    c = 1e-3
+    q = np.array([1.0, c]) / (1.0 + c)
+    want = np.log(2.0) + (q * np.log(q)).sum()
+    assert gain[0] == pytest.approx(want, rel=1e-9)
+    assert 0.0 < gain[1] <= np.log(2.0) + 1e-12  # both hit, 10 mm apart at ray_sigma 2 mm
+    assert gain[2] == pytest.approx(0.0, abs=1e-12)  # both miss: nothing learnt
+    with pytest.raises(ValueError, match="no model 7"):
+        shape.score_recognition_touches(
+            lib, [eq[0], shape.Hypothesis(name="x", model=7, model_from_world=np.eye(4),
+                                          probability=0.5)], origins, dirs)
+    with pytest.raises(ValueError, match="rigid|model_from_world"):
+        shape.Hypothesis(name="x", model=0, model_from_world=np.ones((4, 4)), probability=1.0)

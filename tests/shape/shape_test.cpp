@@ -680,6 +680,24 @@ TEST_CASE("Explorer: the incrementally resampled field equals a fresh sample",
   }
   CHECK(near_sigma < 1e-3);
   CHECK_THROWS_WITH(sh::Explorer<>({.free_cap = 0.0}), Catch::Contains("free_cap"));
+
+  // Rebuilt from its parts, it answers and goes on as the original.
+  std::vector<std::optional<std::size_t>> ids(ex.cloud().size());
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    ids[i] = ex.surface_id(static_cast<taxel::index::PointId>(i));
+  sh::Explorer<> twin(ex.config(), ex.cloud(), ex.surface(), ids);
+  CHECK(twin.field() == ex.field());
+  auto wrong = ids;
+  wrong.pop_back();
+  CHECK_THROWS_WITH(sh::Explorer<>(ex.config(), ex.cloud(), ex.surface(), wrong),
+                    Catch::Contains("surface ids for"));
+  wrong = ids;
+  wrong[1] = wrong[0];
+  CHECK_THROWS_WITH(sh::Explorer<>(ex.config(), ex.cloud(), ex.surface(), wrong),
+                    Catch::Contains("is not a live surface point of its own"));
+  const auto third = batch(0.016, 50);
+  CHECK(twin.add_contacts(third) == ex.add_contacts(third));
+  CHECK(twin.field() == ex.field());
 }
 
 TEST_CASE("sim::poke meets the surface where the ray does, and misses cleanly", "[shape][sim]") {

@@ -54,12 +54,45 @@ template <Kernel K = Matern32,
           class Cloud = fusion::ContactCloud<fusion::Surfel<double>, index::VoxelHash<double>>>
 class Explorer {
  public:
+  /// The fused cloud's type.
+  using CloudType = Cloud;
+
   /// Throws std::invalid_argument for an invalid configuration.
   explicit Explorer(const ExplorerConfig& config = {}, const typename Cloud::Config& fusion = {})
       : config_(checked(config)),
         cloud_(fusion),
         surface_(config_.surface, K(config_.kernel)),
         grid_(Grid::covering(config_.workspace_min, config_.workspace_max, config_.grid_spacing)) {}
+
+  /// Rebuilds an explorer from saved parts, as loading a saved one does: `cloud` and `surface`
+  /// as they were, and surface_ids[i] the surface point of the cloud's point i (surface_id).
+  /// Throws std::invalid_argument for an invalid configuration or parts that do not fit
+  /// together (a size that differs, an id the surface does not have, or one given twice).
+  Explorer(const ExplorerConfig& config, Cloud cloud, ImplicitSurface<K> surface,
+           std::vector<std::optional<std::size_t>> surface_ids)
+      : Explorer(config) {
+    if (surface_ids.size() != cloud.size())
+      throw std::invalid_argument("Explorer: " + std::to_string(surface_ids.size()) +
+                                  " surface ids for " + std::to_string(cloud.size()) +
+                                  " fused points");
+    std::vector<bool> used(surface.id_count(), false);
+    for (const auto& id : surface_ids) {
+      if (!id) continue;
+      if (*id >= surface.id_count() || used[*id] || !surface.point(*id).alive ||
+          surface.point(*id).free)
+        throw std::invalid_argument("Explorer: surface id " + std::to_string(*id) +
+                                    " is not a live surface point of its own");
+      used[*id] = true;
+    }
+    cloud_ = std::move(cloud);
+    surface_ = std::move(surface);
+    of_cloud_ = std::move(surface_ids);
+  }
+
+  /// The surface point of fused point `id`, if it has one.
+  [[nodiscard]] std::optional<std::size_t> surface_id(index::PointId id) const {
+    return id < of_cloud_.size() ? of_cloud_[id] : std::nullopt;
+  }
 
   /// Fuses `contacts` and brings the surface up to date. Returns how many fused points were
   /// added or moved.
