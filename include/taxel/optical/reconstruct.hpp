@@ -70,10 +70,14 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
   }
   Colour change = colour_change(frame, cal.background);
   // A frame far darker than the background (the lights off, the lens covered) or far brighter
-  // (saturated) shows no gel: refused rather than read as a press over the whole frame.
-  const double level = (change[0].mean() + change[1].mean() + change[2].mean()) / 3.0;
+  // (saturated) shows no gel: refused rather than read as a press over the whole frame. The
+  // change's mean is the frame's minus the background's.
   const double base =
-      (cal.background[0].mean() + cal.background[1].mean() + cal.background[2].mean()) / 3.0;
+      (cal.background[0].sum() + cal.background[1].sum() + cal.background[2].sum()) /
+      double(3 * frame.rows * frame.cols);
+  std::uint64_t bytes = 0;
+  for (const std::uint8_t v : frame.data) bytes += v;
+  const double level = double(bytes) / double(frame.data.size()) - base;
   if (!(std::abs(level) <= 0.5 * base)) {
     throw std::invalid_argument(
         "reconstruct: the frame's mean level differs from the "
@@ -97,13 +101,25 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
   out.mask = touched_mask(change, cal.threshold, min_area);
   // The mask's bounding box, grown with it: the loops below stay inside it.
   int r0 = cal.rows, r1 = -1, c0 = cal.cols, c1 = -1;
-  for (int r = 0; r < cal.rows; ++r) {
+  {
+    // Rows, then columns, that hold any of the mask (a running maximum, no branch per pixel).
+    std::vector<std::uint8_t> in_col(static_cast<std::size_t>(cal.cols), 0);
+    for (int r = 0; r < cal.rows; ++r) {
+      const std::uint8_t* row = out.mask.data() + static_cast<std::ptrdiff_t>(r) * cal.cols;
+      std::uint8_t any = 0;
+      for (int c = 0; c < cal.cols; ++c) {
+        in_col[static_cast<std::size_t>(c)] |= row[c];
+        any |= row[c];
+      }
+      if (any) {
+        r0 = std::min(r0, r);
+        r1 = r;
+      }
+    }
     for (int c = 0; c < cal.cols; ++c) {
-      if (!out.mask(r, c)) continue;
-      r0 = std::min(r0, r);
-      r1 = std::max(r1, r);
+      if (!in_col[static_cast<std::size_t>(c)]) continue;
       c0 = std::min(c0, c);
-      c1 = std::max(c1, c);
+      c1 = c;
     }
   }
   image::Mask grown = out.mask;
@@ -159,14 +175,19 @@ HeightMap reconstruct(const RgbFrame& frame, const Calibration& cal, PoissonSolv
             .integrate(out.gx.block(top, left, rows, cols), out.gy.block(top, left, rows, cols),
                        cal.pixel, PoissonBorder::free, untouched);
   }
-  double deepest = 0;
-  for (Eigen::Index i = 0; i < out.mask.size(); ++i) {
-    if (out.mask.data()[i]) deepest = std::max(deepest, out.height.data()[i]);
-  }
+  // The mask, and so the contact, lies within rows r0..r1 and columns c0..c1 (grown).
   out.contact = image::Mask::Zero(cal.rows, cal.cols);
-  for (Eigen::Index i = 0; i < out.mask.size(); ++i) {
-    out.contact.data()[i] = out.mask.data()[i] && deepest > 0 &&
-                            out.height.data()[i] >= options.contact_share * deepest;
+  if (r1 < 0) return out;
+  double deepest = 0;
+  for (int r = r0; r <= r1; ++r) {
+    for (int c = c0; c <= c1; ++c) {
+      if (out.mask(r, c)) deepest = std::max(deepest, out.height(r, c));
+    }
+  }
+  if (!(deepest > 0)) return out;
+  const double floor = options.contact_share * deepest;
+  for (int r = r0; r <= r1; ++r) {
+    for (int c = c0; c <= c1; ++c) out.contact(r, c) = out.mask(r, c) && out.height(r, c) >= floor;
   }
   return out;
 }
