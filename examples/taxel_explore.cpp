@@ -20,6 +20,7 @@
 #include "cli.hpp"
 #include "explore_harness.hpp"
 #include "report.hpp"
+#include "sim_shapes.hpp"
 
 namespace {
 
@@ -176,7 +177,7 @@ int main(int argc, char** argv) {
       std::fputs(kUsage, stdout);
       return 0;
     } else if (a == "--shape") {
-      o.shape = std::string(args.choice("sphere|cylinder|box|cone|ellipsoid|torus"));
+      o.shape = std::string(args.choice(taxel_cli::kShapeNames));
       shape_given = true;
     } else if (a == "--size") {
       o.size = numbers(args, args.value());
@@ -240,53 +241,15 @@ int main(int argc, char** argv) {
     o.settings.library = &*library;
   }
 
-  const auto dims = [&](std::size_t n, std::vector<double> fallback) {
-    if (o.size.empty()) return fallback;
-    if (o.size.size() != n) {
-      args.fail("--size for a " + o.shape + " takes " + std::to_string(n) + " length(s), got " +
-                std::to_string(o.size.size()));
-    }
-    return o.size;
-  };
   try {
     if (!o.mesh.empty()) {
-      taxel::io::PlyData ply;
-      try {
-        ply = taxel::io::parse_ply(taxel_cli::read_input(o.mesh), taxel_cli::input_name(o.mesh));
-      } catch (const std::exception& e) {
-        args.fail(e.what(), 1);
-      }
-      taxel_cli::warn_if_millimetres("taxel-explore", taxel_cli::input_name(o.mesh),
-                                     taxel_cli::largest_extent(ply.cloud.points));
-      std::optional<ts::TriangleMesh> mesh;
-      try {
-        mesh.emplace(std::move(ply.cloud.points), std::move(ply.triangles));
-      } catch (const std::invalid_argument& e) {
-        args.fail(taxel_cli::input_name(o.mesh) + ": " + e.what(), 1);
-      }
-      return run(o, taxel_explore::AnyShape::of(std::move(*mesh)), args);
+      return run(
+          o, taxel_explore::AnyShape::of(taxel_cli::read_mesh(o.mesh, 1.0, "taxel-explore", args)),
+          args);
     }
-    if (o.shape == "sphere")
-      return run(o, taxel_explore::AnyShape::of(ts::Sphere(dims(1, {0.03})[0])), args);
-    if (o.shape == "cylinder") {
-      const auto d = dims(2, {0.025, 0.04});
-      return run(o, taxel_explore::AnyShape::of(ts::Cylinder(d[0], d[1])), args);
-    }
-    if (o.shape == "box") {
-      const auto d = dims(3, {0.04, 0.03, 0.02});
-      return run(o, taxel_explore::AnyShape::of(ts::Box(taxel::Vec3d(d[0], d[1], d[2]))), args);
-    }
-    if (o.shape == "cone") {
-      const auto d = dims(2, {0.03, 0.06});
-      return run(o, taxel_explore::AnyShape::of(ts::Cone(d[0], d[1])), args);
-    }
-    if (o.shape == "ellipsoid") {
-      const auto d = dims(3, {0.045, 0.035, 0.025});
-      return run(o, taxel_explore::AnyShape::of(ts::Ellipsoid(taxel::Vec3d(d[0], d[1], d[2]))),
-                 args);
-    }
-    const auto d = dims(2, {0.035, 0.012});
-    return run(o, taxel_explore::AnyShape::of(ts::Torus(d[0], d[1])), args);
+    return taxel_cli::with_shape(o.shape, o.size, {}, args, [&](auto shape) {
+      return run(o, taxel_explore::AnyShape::of(std::move(shape)), args);
+    });
   } catch (const std::invalid_argument& e) {
     args.fail(e.what());
   }

@@ -21,6 +21,7 @@
 
 #include "cli.hpp"
 #include "report.hpp"
+#include "sim_shapes.hpp"
 
 namespace {
 
@@ -341,55 +342,17 @@ int main(int argc, char** argv) {
     args.check_output(o.readings, {o.mesh}, {o.poses});
     args.check_output(o.poses, {o.mesh});
   }
-  const auto dims = [&](std::size_t n, std::vector<double> fallback) {
-    if (o.size.empty()) return fallback;
-    if (o.size.size() != n) {
-      args.fail("--size for a " + o.shape + " takes " + std::to_string(n) + " number(s), got " +
-                std::to_string(o.size.size()));
-    }
-    return o.size;
-  };
   try {
     o.config.validate();
-    if (o.shape == "sphere") return run(o, ts::Sphere(dims(1, {0.04})[0]), args);
-    if (o.shape == "cylinder") {
-      const auto d = dims(2, {0.03, 0.05});
-      return run(o, ts::Cylinder(d[0], d[1]), args);
-    }
-    if (o.shape == "box") {
-      const auto d = dims(3, {0.04, 0.03, 0.02});
-      return run(o, ts::Box(taxel::Vec3d(d[0], d[1], d[2])), args);
-    }
-    if (o.shape == "cone") {
-      const auto d = dims(2, {0.03, 0.06});
-      return run(o, ts::Cone(d[0], d[1]), args);
-    }
-    if (o.shape == "ellipsoid") {
-      const auto d = dims(3, {0.05, 0.035, 0.025});
-      return run(o, ts::Ellipsoid(taxel::Vec3d(d[0], d[1], d[2])), args);
-    }
-    if (o.shape == "torus") {
-      const auto d = dims(2, {0.04, 0.015});
-      return run(o, ts::Torus(d[0], d[1]), args);
-    }
-    taxel::io::PlyData ply;
-    try {
-      ply = taxel::io::parse_ply(taxel_cli::read_input(o.mesh), taxel_cli::input_name(o.mesh));
-    } catch (const std::exception& e) {
-      args.fail(e.what(), 1);
-    }
-    if (o.scale != 1.0) {
-      for (auto& p : ply.cloud.points) p *= o.scale;
-    }
-    taxel_cli::warn_if_millimetres("taxel-simulate", taxel_cli::input_name(o.mesh),
-                                   taxel_cli::largest_extent(ply.cloud.points));
-    std::optional<ts::TriangleMesh> mesh;
-    try {
-      mesh.emplace(std::move(ply.cloud.points), std::move(ply.triangles));
-    } catch (const std::invalid_argument& e) {  // a mesh TriangleMesh refuses is bad data
-      args.fail(taxel_cli::input_name(o.mesh) + ": " + e.what(), 1);
-    }
-    return run(o, *mesh, args);
+    if (o.shape == "mesh")
+      return run(o, taxel_cli::read_mesh(o.mesh, o.scale, "taxel-simulate", args), args);
+    taxel_cli::ShapeSizes sizes;
+    sizes.sphere = {0.04};
+    sizes.cylinder = {0.03, 0.05};
+    sizes.ellipsoid = {0.05, 0.035, 0.025};
+    sizes.torus = {0.04, 0.015};
+    return taxel_cli::with_shape(o.shape, o.size, sizes, args,
+                                 [&](const auto& shape) { return run(o, shape, args); });
   } catch (const std::invalid_argument& e) {  // a shape or exploration parameter out of range
     args.fail(e.what());
   }
