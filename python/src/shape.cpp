@@ -239,9 +239,14 @@ surface's variance. Lengths in metres.)doc");
           py::arg("length_scale") = 0.02, py::arg("sigma") = 0.01,
           "An empty surface (prior_centre None: the origin); ValueError naming a setting out "
           "of range.")
-      .def("__len__", [](const Surface& s) { return s.size(); })
+      .def("__len__",
+           [](const Surface& s) {
+             const auto lock = read_lock(&s);
+             return s.size();
+           })
       .def("__repr__",
            [](const Surface& s) {
+             const auto lock = read_lock(&s);
              char text[200];
              std::snprintf(text, sizeof text,
                            "ImplicitSurface(%zu points, %zu experts, expert_size=%g, "
@@ -250,12 +255,26 @@ surface's variance. Lengths in metres.)doc");
                            s.kernel().config().length_scale, s.config().prior_radius);
              return std::string(text);
            })
-      .def_property_readonly("expert_count", &Surface::expert_count, "number of experts")
       .def_property_readonly(
-          "prior_centre", [](const Surface& s) { return vec_array(s.config().prior_centre); },
+          "expert_count",
+          [](const Surface& s) {
+            const auto lock = read_lock(&s);
+            return s.expert_count();
+          },
+          "number of experts")
+      .def_property_readonly(
+          "prior_centre",
+          [](const Surface& s) {
+            const auto lock = read_lock(&s);
+            return vec_array(s.config().prior_centre);
+          },
           "centre of the prior sphere [m]")
       .def_property_readonly(
-          "prior_radius", [](const Surface& s) { return s.config().prior_radius; },
+          "prior_radius",
+          [](const Surface& s) {
+            const auto lock = read_lock(&s);
+            return s.config().prior_radius;
+          },
           "radius of the prior sphere [m]")
       .def(
           "insert",
@@ -575,7 +594,11 @@ surface's variance. Lengths in metres.)doc");
          py::arg("free_threshold") = 5e-3, py::arg("free_cap") = 3e-3,
          "An explorer with nothing touched yet; the workspace box defaults to +-60 mm around the "
          "origin. ValueError naming a setting out of range.")
-      .def("__len__", [](const Explorer& e) { return e.cloud().size(); })
+      .def("__len__",
+           [](const Explorer& e) {
+             const auto lock = read_lock(&e);
+             return e.cloud().size();
+           })
       .def("__repr__",
            [](const Explorer& e) {
              const auto lock = read_lock(&e);
