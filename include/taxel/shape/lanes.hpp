@@ -65,8 +65,12 @@ template <class V>
       reinterpret_cast<V>((reinterpret_cast<U>(x_in) & ~low) | (reinterpret_cast<U>(floor) & low));
   constexpr double log2e = 1.4426950408889634, ln2_hi = 0.693147180369123816490,
                    ln2_lo = 1.90821492927058770002e-10, shift = 0x1.8p52;
-  const V shifted = x * log2e + shift;  // n in the low bits of the mantissa
-  const V n = shifted - shift;
+  V shifted = x * log2e + shift;  // n in the low bits of the mantissa
+  // Both opaque to the optimiser: with -ffast-math it would fold (shifted - shift) into
+  // x * log2e, or distribute n * ln2 over it, and lose the rounding to n (errors of 40 %).
+  __asm__("" : "+x"(shifted));
+  V n = shifted - shift;
+  __asm__("" : "+x"(n));
   const V t = (x - n * ln2_hi) - n * ln2_lo;
   // 1/k! for k = 12 .. 0
   V p = V{} + 1.0 / 479001600.0;
