@@ -60,13 +60,6 @@ ArrayD plane_array(const Plane& p) {
   return out;
 }
 
-py::array_t<bool> mask_array(const image::Mask& m) {
-  py::array_t<bool> out({m.rows(), m.cols()});
-  bool* p = out.mutable_data();
-  for (Eigen::Index i = 0; i < m.size(); ++i) p[i] = m.data()[i] != 0;
-  return out;
-}
-
 /// Dots from find_dots' (dots, 3) array: column, row, area.
 std::vector<to::Dot> dots_from(const ArrayD& dots) {
   require_shape(dots, {-1, 3}, "dots", "(dots, 3)");
@@ -93,13 +86,24 @@ struct Reconstructor {
   }
 };
 
-py::dict height_map_dict(const to::HeightMap& m) {
+/// The map's arrays handed to numpy without a copy: each a view of the map's own planes, which
+/// a capsule keeps alive until the last array is gone. The masks hold 0 and 1, numpy's bools.
+py::dict height_map_dict(to::HeightMap&& m) {
+  for (image::Mask* mask : {&m.mask, &m.contact}) *mask = (*mask != 0).cast<std::uint8_t>();
+  auto* held = new to::HeightMap(std::move(m));
+  const py::capsule owner(held, [](void* p) { delete static_cast<to::HeightMap*>(p); });
+  const auto plane = [&](const to::Plane& p) {
+    return py::array_t<double>({p.rows(), p.cols()}, p.data(), owner);
+  };
+  const auto mask = [&](const image::Mask& k) {
+    return py::array_t<bool>({k.rows(), k.cols()}, reinterpret_cast<const bool*>(k.data()), owner);
+  };
   py::dict d;
-  d["height"] = plane_array(m.height);
-  d["gx"] = plane_array(m.gx);
-  d["gy"] = plane_array(m.gy);
-  d["mask"] = mask_array(m.mask);
-  d["contact"] = mask_array(m.contact);
+  d["height"] = plane(held->height);
+  d["gx"] = plane(held->gx);
+  d["gy"] = plane(held->gy);
+  d["mask"] = mask(held->mask);
+  d["contact"] = mask(held->contact);
   return d;
 }
 
