@@ -14,9 +14,11 @@
 #include <cstdint>
 #include <cstring>
 
+// The square roots below are the compilers' builtins behind _mm_sqrt_pd and _mm256_sqrt_pd
+// (GCC's and Clang's alike): <immintrin.h> would add about half a second to every translation
+// unit that includes taxel.
 #if !defined(TAXEL_NO_SIMD_DISPATCH) && defined(__GNUC__) && defined(__x86_64__)
 #define TAXEL_SHAPE_LANES 1
-#include <immintrin.h>
 #else
 #define TAXEL_SHAPE_LANES 0
 #endif
@@ -33,10 +35,14 @@ struct Bits;
 template <>
 struct Bits<D2> {
   using type = U2;
+  using int32 = std::int32_t __attribute__((vector_size(8)));
+  using int64 = std::int64_t __attribute__((vector_size(16)));
 };
 template <>
 struct Bits<D4> {
   using type = U4;
+  using int32 = std::int32_t __attribute__((vector_size(16)));
+  using int64 = std::int64_t __attribute__((vector_size(32)));
 };
 
 // Every helper takes and gives vectors by reference: a 32-byte vector passed by value in code
@@ -64,13 +70,13 @@ template <class V>
   const V x =
       reinterpret_cast<V>((reinterpret_cast<U>(x_in) & ~low) | (reinterpret_cast<U>(floor) & low));
   constexpr double log2e = 1.4426950408889634, ln2_hi = 0.693147180369123816490,
-                   ln2_lo = 1.90821492927058770002e-10, shift = 0x1.8p52;
-  V shifted = x * log2e + shift;  // n in the low bits of the mantissa
-  // Both opaque to the optimiser: with -ffast-math it would fold (shifted - shift) into
-  // x * log2e, or distribute n * ln2 over it, and lose the rounding to n (errors of 40 %).
-  __asm__("" : "+x"(shifted));
-  V n = shifted - shift;
-  __asm__("" : "+x"(n));
+                   ln2_lo = 1.90821492927058770002e-10;
+  // n = x / ln 2 rounded to the nearest integer (x <= 0: truncating x / ln 2 - 1/2), through
+  // integer lanes: unlike adding and subtracting 1.5 * 2^52, -ffast-math cannot fold it away.
+  using I32 = typename Bits<V>::int32;
+  using I64 = typename Bits<V>::int64;
+  const I32 k = __builtin_convertvector(x * log2e - 0.5, I32);
+  const V n = __builtin_convertvector(k, V);
   const V t = (x - n * ln2_hi) - n * ln2_lo;
   // 1/k! for k = 12 .. 0
   V p = V{} + 1.0 / 479001600.0;
@@ -86,7 +92,7 @@ template <class V>
   p = p * t + 0.5;
   p = p * t + 1.0;
   p = p * t + 1.0;
-  const U two_n = (reinterpret_cast<U>(shifted) + 1023) << 52;
+  const U two_n = reinterpret_cast<U>((__builtin_convertvector(k, I64) + 1023) << 52);
   out = p * reinterpret_cast<V>(two_n);
 }
 
@@ -142,7 +148,7 @@ double kernel_sum_sse2(const K& kernel, std::size_t n, const double* const* p, c
     load(p[2] + i, oz);
     load(w + i, wi);
     const D2 dx = qx - ox, dy = qy - oy, dz = qz - oz;
-    const D2 r = _mm_sqrt_pd(dx * dx + dy * dy + dz * dz);
+    const D2 r = __builtin_ia32_sqrtpd(dx * dx + dy * dy + dz * dz);
     accumulate<Gradient>(kernel, dx, dy, dz, r, wi, acc);
   }
   return finish<Gradient>(kernel, i, n, p, x, w, gradient, acc);
@@ -163,7 +169,7 @@ template <bool Gradient, class K>
     load(p[2] + i, oz);
     load(w + i, wi);
     const D4 dx = qx - ox, dy = qy - oy, dz = qz - oz;
-    const D4 r = _mm256_sqrt_pd(dx * dx + dy * dy + dz * dz);
+    const D4 r = __builtin_ia32_sqrtpd256(dx * dx + dy * dy + dz * dz);
     accumulate<Gradient>(kernel, dx, dy, dz, r, wi, acc);
   }
   return finish<Gradient>(kernel, i, n, p, x, w, gradient, acc);
