@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The SIMD-lane kernel sums (shape/lanes.hpp) built with -ffast-math, as a user's project may
-// build them: their exponential rounds x / ln 2 to an integer by adding and subtracting
-// 1.5 * 2^52, which the optimiser would fold away under -ffast-math (errors of 40 %) without
-// the barriers the header places. Checked against std::exp and plain sums.
+// build them. Their exponential rounds x / ln 2 to an integer; done by adding and subtracting
+// 1.5 * 2^52, the optimiser folds that away under -ffast-math (errors of 40 %), so the header
+// rounds through integer lanes. Checked against std::exp and plain sums.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
