@@ -74,7 +74,6 @@ template <class V>
   // n = x / ln 2 rounded to the nearest integer (x <= 0: truncating x / ln 2 - 1/2), through
   // integer lanes: unlike adding and subtracting 1.5 * 2^52, -ffast-math cannot fold it away.
   using I32 = typename Bits<V>::int32;
-  using I64 = typename Bits<V>::int64;
   const I32 k = __builtin_convertvector(x * log2e - 0.5, I32);
   const V n = __builtin_convertvector(k, V);
   const V t = (x - n * ln2_hi) - n * ln2_lo;
@@ -92,7 +91,9 @@ template <class V>
   p = p * t + 0.5;
   p = p * t + 1.0;
   p = p * t + 1.0;
-  const U two_n = reinterpret_cast<U>((__builtin_convertvector(k, I64) + 1023) << 52);
+  // 2^n: n + 1023 in the low bits of a double's mantissa (n is an integer, so the sum is
+  // exact), shifted into the exponent.
+  const U two_n = reinterpret_cast<U>(n + (0x1p52 + 1023.0)) << 52;
   out = p * reinterpret_cast<V>(two_n);
 }
 
