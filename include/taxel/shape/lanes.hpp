@@ -36,13 +36,11 @@ template <>
 struct Bits<D2> {
   using type = U2;
   using int32 = std::int32_t __attribute__((vector_size(8)));
-  using int64 = std::int64_t __attribute__((vector_size(16)));
 };
 template <>
 struct Bits<D4> {
   using type = U4;
   using int32 = std::int32_t __attribute__((vector_size(16)));
-  using int64 = std::int64_t __attribute__((vector_size(32)));
 };
 
 // Every helper takes and gives vectors by reference: a 32-byte vector passed by value in code
