@@ -141,6 +141,14 @@ Explorer make_explorer(const std::optional<ArrayD>& workspace_min,
   }
 }
 
+/// Doubles in one point state of the Explorer's fused cloud (Surfel's for_each_field).
+std::size_t surfel_state_size() {
+  std::size_t k = 0;
+  fusion::Surfel<double>::State probe{};
+  fusion::Surfel<double>::for_each_field(probe, [&](double*, std::size_t len) { k += len; });
+  return k;
+}
+
 constexpr const char* kExplorerDoc = R"doc(
 The loop of exploring an object by touch: contacts are fused (Surfel over VoxelHash), the fused
 points feed an implicit surface (see ImplicitSurface; its settings here have the same names),
@@ -518,9 +526,7 @@ surface's variance. Lengths in metres.)doc");
                            c.kernel.sigma, c.scoring.noise_sigma, c.scoring.radius,
                            c.scoring.target_spacing, c.free_spacing, c.free_threshold, c.free_cap);
         using F = fusion::Surfel<double>;
-        std::size_t k = 0;
-        F::State probe{};
-        F::for_each_field(probe, [&](double*, std::size_t len) { k += len; });
+        const std::size_t k = surfel_state_size();
         const auto n = static_cast<py::ssize_t>(e.cloud().size());
         ArrayD states({n, static_cast<py::ssize_t>(k)}), times(n);
         py::array_t<std::uint32_t> obs(n);
@@ -551,9 +557,7 @@ surface's variance. Lengths in metres.)doc");
             t[12].cast<double>(), t[13].cast<double>(), t[14].cast<double>(), t[15].cast<double>(),
             t[16].cast<double>(), t[17].cast<double>());
         using F = fusion::Surfel<double>;
-        std::size_t k = 0;
-        F::State probe{};
-        F::for_each_field(probe, [&](double*, std::size_t len) { k += len; });
+        const std::size_t k = surfel_state_size();
         const auto states = a[1].cast<ArrayD>();
         const auto obs = a[2].cast<StrictArray<std::uint32_t>>();
         const auto times = a[3].cast<ArrayD>();
